@@ -1,0 +1,195 @@
+/*
+ * shortcrust: surface reconstruction from unorganized 3D points by one-pass
+ * Delaunay filtering (Amenta & Choi, "the short crust").
+ *
+ * This header is the whole public face of the core. It is plain C; the
+ * implementation is C++ over CGAL and never lets an exception cross it.
+ *
+ * Points go in as an array of double x,y,z triples. Triangles come out as
+ * index triples into that same array, so the caller keeps its coordinates.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#ifndef SHORTCRUST_H
+#define SHORTCRUST_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/*
+ * Error codes. Every function that can fail returns 0 or one of these
+ * negative values; sc_strerror() and sc_err_name() describe them.
+ */
+#define SC_ERRNO_MAP(X)                                                        \
+  X(INVALID_ARGUMENT, -1, "invalid argument")                                  \
+  X(DEGENERATE_INPUT, -2,                                                      \
+    "degenerate input: fewer than 4 distinct points, or all coplanar")         \
+  X(NONFINITE, -3, "non-finite coordinate (NaN or Inf) in the input")          \
+  X(NO_MEMORY, -4, "out of memory")                                            \
+  X(CANCELLED, -5, "cancelled")                                                \
+  X(TOO_MANY_POINTS, -6, "too many points (at most 2^32 - 2)")                 \
+  X(INTERNAL, -7, "internal error")                                            \
+  X(BAD_STATE, -8, "call not allowed in the current state")
+
+typedef enum sc_err {
+  SC_OK = 0,
+#define SC_ERR_ENUM_(name, value, msg) SC_E##name = (value),
+  SC_ERRNO_MAP(SC_ERR_ENUM_)
+#undef SC_ERR_ENUM_
+} sc_err_t;
+
+/* A fixed English message for a code; "unknown error" for other values. */
+const char *sc_strerror(int code);
+/* The code's name without the prefix, e.g. "NONFINITE"; "UNKNOWN" otherwise. */
+const char *sc_err_name(int code);
+
+/* Candidate selection (ALGORITHM.md section 3, and section 6 for the rest). */
+typedef enum sc_mode {
+  /* The paper's two criteria (normal and small ball) with parameter r. */
+  SC_MODE_SHORTCRUST = 0,
+  /* The cocone test: the dual Voronoi edge meets the cocone of all three
+   * vertices. */
+  SC_MODE_COCONE = 1,
+  /* Count of modes; not a mode. */
+  SC_MODE_COUNT_
+} sc_mode_t;
+
+/* The stages of a reconstruction, in the order they run. */
+typedef enum sc_stage {
+  SC_STAGE_INPUT = 0,      /* validation, duplicate detection */
+  SC_STAGE_DELAUNAY = 1,   /* the 3D Delaunay triangulation */
+  SC_STAGE_POLES = 2,      /* Voronoi vertices and poles */
+  SC_STAGE_CANDIDATES = 3, /* one pass over the Delaunay facets */
+  SC_STAGE_PRUNE = 4,      /* sharp-edge pruning */
+  SC_STAGE_EXTRACT = 5,    /* manifold extraction and orientation */
+  SC_STAGE_COUNT = 6
+} sc_stage_t;
+
+/* Short lower-case name of a stage ("delaunay", ...); "?" when out of range. */
+const char *sc_stage_name(int stage);
+
+/*
+ * Progress callback: called from the thread running the reconstruction with
+ * the current stage and the fraction of that stage done, in [0, 1]. Return 0
+ * to go on, non-zero to cancel: the call then returns SC_ECANCELLED at the
+ * next check (at most a few milliseconds of work later) and frees everything
+ * it held.
+ */
+typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
+
+typedef struct sc_params {
+  /* Candidate test. Default SC_MODE_COCONE. */
+  sc_mode_t mode;
+  /* Sampling parameter of the shortcrust criteria, in (0, 0.5). The paper
+   * proves its guarantees for r < 1/7; larger values accept more triangles
+   * on sparser or less even samples. Default 0.25 (see the README for the
+   * measurements behind it). Ignored by the cocone test. */
+  double r;
+  /* Half-width of the cocone around the plane normal to the pole, radians,
+   * in (0, pi/2). Default pi/8: the cocone is |cos angle(y - s, pole)| <=
+   * cos(pi/2 - theta). */
+  double cocone_theta;
+  /* Worker threads for the Delaunay triangulation and the candidate pass;
+   * 0 means one per core. Default 1. */
+  int threads;
+  /* Optional progress and cancellation; NULL for none. */
+  sc_progress_fn progress;
+  void *progress_user;
+} sc_params_t;
+
+/* Fills *p with the documented defaults. */
+void sc_params_init(sc_params_t *p);
+
+/* Diagnostics of one reconstruction (ALGORITHM.md section 7). */
+typedef struct sc_diag {
+  uint64_t points_in;          /* points given */
+  uint64_t duplicates_merged;  /* exact duplicates of an earlier point */
+  uint64_t delaunay_vertices;  /* distinct points in the triangulation */
+  uint64_t delaunay_cells;     /* finite tetrahedra */
+  uint64_t delaunay_facets;    /* finite triangles */
+  uint64_t hull_vertices;      /* samples on the convex hull */
+  uint64_t degenerate_cells;   /* flat cells whose circumcentre was guarded */
+  uint64_t candidates;         /* triangles passing the candidate test */
+  uint64_t pruned;             /* candidates removed for a sharp edge */
+  uint64_t triangles;          /* triangles in the output */
+  uint64_t walk_rejected;      /* survivors of pruning left out by the walk */
+  uint64_t samples_unused;     /* distinct samples in no output triangle */
+  uint64_t boundary_edges;     /* output edges with a single triangle */
+  uint64_t boundary_loops;     /* closed loops of boundary edges */
+  uint64_t nonmanifold_edges;  /* always 0 on success; kept as a check */
+  uint64_t nonmanifold_vertices; /* always 0 on success; kept as a check */
+  uint64_t components;         /* edge-connected components of the output */
+  uint64_t closed_components;  /* components without boundary */
+  int closed;                  /* 1 when the whole output has no boundary */
+  int64_t euler;               /* V - E + F over the used vertices */
+  int64_t genus;               /* sum of the genera of closed components */
+  double seconds[SC_STAGE_COUNT]; /* wall time per stage */
+  double seconds_total;
+} sc_diag_t;
+
+/* The result of a reconstruction. Free with sc_mesh_free(). */
+typedef struct sc_mesh {
+  /* 3 * triangle_count indices into the caller's point array. Every closed
+   * component is oriented outward (counter-clockwise seen from outside). */
+  uint32_t *triangles;
+  size_t triangle_count;
+  /* 3 * point_count unit normals, one per input point, oriented like the
+   * triangles around it; zero for a point in no triangle. A duplicate gets
+   * its first occurrence's normal. */
+  double *normals;
+  size_t point_count;
+  /* Genus of each closed component, component_count entries in the order
+   * the components were found; -1 for a component with boundary. */
+  int32_t *component_genus;
+  size_t component_count;
+  sc_diag_t diag;
+} sc_mesh_t;
+
+void sc_mesh_free(sc_mesh_t *mesh);
+
+/*
+ * One-call reconstruction of n points (xyz holds 3n doubles). On success
+ * returns 0 and sets *out to a mesh the caller frees. On failure returns a
+ * negative code, sets *out to NULL, and writes a one-line explanation (for
+ * example the index of the first non-finite coordinate) to msg when msg is
+ * not NULL.
+ */
+int sc_reconstruct(const double *xyz, size_t n, const sc_params_t *params,
+                   sc_mesh_t **out, char *msg, size_t msg_len);
+
+/*
+ * Streaming reconstruction, for points that arrive in chunks: the Delaunay
+ * insertion of each chunk runs in sc_recon_add(), while later chunks are
+ * still on their way.
+ *
+ *   sc_recon_t *r;  sc_recon_new(&params, &r);
+ *   sc_recon_add(r, chunk, k, ...);   (any number of times)
+ *   sc_recon_finish(r, &mesh, ...);
+ *   sc_recon_free(r);
+ *
+ * Indices in the result count the points in the order they were added. A
+ * failed sc_recon_add() leaves the reconstruction unusable except for
+ * sc_recon_free(). Not thread-safe: one thread at a time per object.
+ */
+typedef struct sc_recon sc_recon_t;
+
+int sc_recon_new(const sc_params_t *params, sc_recon_t **out);
+int sc_recon_add(sc_recon_t *r, const double *xyz, size_t n, char *msg,
+                 size_t msg_len);
+int sc_recon_finish(sc_recon_t *r, sc_mesh_t **out, char *msg, size_t msg_len);
+void sc_recon_free(sc_recon_t *r);
+
+/* Approximate bytes a reconstruction of n points holds at its peak, for
+ * admission control. Measured; see the README. */
+uint64_t sc_estimate_bytes(uint64_t n);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SHORTCRUST_H */
