@@ -1,0 +1,214 @@
+// The C boundary of the core: error tables, defaults, and the functions that
+// turn every C++ exception into an error code.
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+
+#include "internal.hpp"
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <new>
+#include <stdexcept>
+
+extern "C" const char *sc_strerror(int code) {
+  switch (code) {
+  case SC_OK:
+    return "success";
+#define SC_ERR_MSG_(name, value, msg)                                           \
+  case value:                                                                  \
+    return msg;
+    SC_ERRNO_MAP(SC_ERR_MSG_)
+#undef SC_ERR_MSG_
+  }
+  return "unknown error";
+}
+
+extern "C" const char *sc_err_name(int code) {
+  switch (code) {
+  case SC_OK:
+    return "OK";
+#define SC_ERR_NAME_(name, value, msg)                                          \
+  case value:                                                                  \
+    return #name;
+    SC_ERRNO_MAP(SC_ERR_NAME_)
+#undef SC_ERR_NAME_
+  }
+  return "UNKNOWN";
+}
+
+extern "C" const char *sc_stage_name(int stage) {
+  static const char *const names[SC_STAGE_COUNT] = {
+      "input", "delaunay", "poles", "candidates", "prune", "extract"};
+  if (stage < 0 || stage >= SC_STAGE_COUNT)
+    return "?";
+  return names[stage];
+}
+
+extern "C" void sc_params_init(sc_params_t *p) {
+  if (!p)
+    return;
+  std::memset(p, 0, sizeof *p);
+  p->mode = SC_MODE_COCONE;
+  p->r = 0.25;
+  p->cocone_theta = M_PI / 8;
+  p->threads = 1;
+}
+
+namespace sc {
+
+void set_msg(char *msg, size_t len, const char *fmt, ...) {
+  if (!msg || len == 0)
+    return;
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(msg, len, fmt, ap);
+  va_end(ap);
+}
+
+int check_params(const sc_params_t *p, char *msg, size_t len) {
+  if (p->mode < 0 || p->mode >= SC_MODE_COUNT_) {
+    set_msg(msg, len, "unknown mode %d", (int)p->mode);
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (!(p->r > 0 && p->r < 0.5)) {
+    set_msg(msg, len, "r must be in (0, 0.5), got %g", p->r);
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (!(p->cocone_theta > 0 && p->cocone_theta < M_PI / 2)) {
+    set_msg(msg, len, "cocone_theta must be in (0, pi/2), got %g",
+            p->cocone_theta);
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (p->threads < 0) {
+    set_msg(msg, len, "threads must be >= 0, got %d", p->threads);
+    return SC_EINVALID_ARGUMENT;
+  }
+  return SC_OK;
+}
+
+} // namespace sc
+
+using sc::set_msg;
+
+// Runs f, turning any exception into an error code and a message.
+template <class F> static int guarded(char *msg, size_t len, F &&f) {
+  try {
+    return f();
+  } catch (const sc::Error &e) {
+    set_msg(msg, len, "%s", e.what());
+    return e.code;
+  } catch (const std::bad_alloc &) {
+    set_msg(msg, len, "%s", sc_strerror(SC_ENO_MEMORY));
+    return SC_ENO_MEMORY;
+  } catch (const std::exception &e) {
+    set_msg(msg, len, "internal error: %s", e.what());
+    return SC_EINTERNAL;
+  } catch (...) {
+    set_msg(msg, len, "internal error: unknown exception");
+    return SC_EINTERNAL;
+  }
+}
+
+struct sc_recon {
+  sc::Recon impl;
+  int failed = 0;
+  int finished = 0;
+};
+
+extern "C" int sc_recon_new(const sc_params_t *params, sc_recon_t **out) {
+  if (!out)
+    return SC_EINVALID_ARGUMENT;
+  *out = nullptr;
+  sc_params_t p;
+  if (params)
+    p = *params;
+  else
+    sc_params_init(&p);
+  int rc = sc::check_params(&p, nullptr, 0);
+  if (rc)
+    return rc;
+  return guarded(nullptr, 0, [&] {
+    *out = new sc_recon{sc::Recon(p)};
+    return SC_OK;
+  });
+}
+
+extern "C" int sc_recon_add(sc_recon_t *r, const double *xyz, size_t n,
+                            char *msg, size_t msg_len) {
+  if (!r || (!xyz && n)) {
+    set_msg(msg, msg_len, "%s", sc_strerror(SC_EINVALID_ARGUMENT));
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (r->failed || r->finished) {
+    set_msg(msg, msg_len, "%s", sc_strerror(SC_EBAD_STATE));
+    return SC_EBAD_STATE;
+  }
+  int rc = guarded(msg, msg_len, [&] {
+    r->impl.add(xyz, n);
+    return SC_OK;
+  });
+  if (rc)
+    r->failed = 1;
+  return rc;
+}
+
+extern "C" int sc_recon_finish(sc_recon_t *r, sc_mesh_t **out, char *msg,
+                               size_t msg_len) {
+  if (out)
+    *out = nullptr;
+  if (!r || !out) {
+    set_msg(msg, msg_len, "%s", sc_strerror(SC_EINVALID_ARGUMENT));
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (r->failed || r->finished) {
+    set_msg(msg, msg_len, "%s", sc_strerror(SC_EBAD_STATE));
+    return SC_EBAD_STATE;
+  }
+  r->finished = 1;
+  return guarded(msg, msg_len, [&] {
+    *out = r->impl.finish();
+    return SC_OK;
+  });
+}
+
+extern "C" void sc_recon_free(sc_recon_t *r) { delete r; }
+
+extern "C" int sc_reconstruct(const double *xyz, size_t n,
+                              const sc_params_t *params, sc_mesh_t **out,
+                              char *msg, size_t msg_len) {
+  if (out)
+    *out = nullptr;
+  if (!out || (!xyz && n)) {
+    set_msg(msg, msg_len, "%s", sc_strerror(SC_EINVALID_ARGUMENT));
+    return SC_EINVALID_ARGUMENT;
+  }
+  sc_params_t p;
+  if (params)
+    p = *params;
+  else
+    sc_params_init(&p);
+  int rc = sc::check_params(&p, msg, msg_len);
+  if (rc)
+    return rc;
+  return guarded(msg, msg_len, [&] {
+    sc::Recon r(p);
+    r.borrow(xyz, n);
+    *out = r.finish();
+    return SC_OK;
+  });
+}
+
+extern "C" void sc_mesh_free(sc_mesh_t *mesh) {
+  if (!mesh)
+    return;
+  std::free(mesh->triangles);
+  std::free(mesh->normals);
+  std::free(mesh->component_genus);
+  std::free(mesh);
+}
+
+extern "C" uint64_t sc_estimate_bytes(uint64_t n) {
+  return sc::kBytesPerPoint * n + (1u << 20);
+}

@@ -1,0 +1,189 @@
+// One reconstruction from input to mesh: validation, the triangulation
+// stages, pruning, extraction, and the result handed back to C.
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+
+#include "internal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+
+namespace sc {
+
+namespace {
+
+constexpr size_t kMaxPoints = 0xFFFFFFFEu;
+
+void check_finite(const double *xyz, size_t n, size_t first) {
+  for (size_t i = 0; i < 3 * n; ++i) {
+    if (!std::isfinite(xyz[i])) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "point %zu has a non-finite %c coordinate (%g)",
+                    first + i / 3, "xyz"[i % 3], xyz[i]);
+      throw Error(SC_ENONFINITE, buf);
+    }
+  }
+}
+
+template <class T> T *copy_out(const T *src, size_t count) {
+  T *p = static_cast<T *>(std::malloc(std::max<size_t>(1, count) * sizeof(T)));
+  if (!p)
+    throw std::bad_alloc();
+  if (count)
+    std::memcpy(p, src, count * sizeof(T));
+  return p;
+}
+
+} // namespace
+
+void Recon::insert_range(size_t first, size_t n) {
+  if (n == 0)
+    return;
+  Progress progress(params_.progress, params_.progress_user);
+  if (!dt_) {
+    double box[6] = {std::numeric_limits<double>::infinity(),
+                     std::numeric_limits<double>::infinity(),
+                     std::numeric_limits<double>::infinity(),
+                     -std::numeric_limits<double>::infinity(),
+                     -std::numeric_limits<double>::infinity(),
+                     -std::numeric_limits<double>::infinity()};
+    for (size_t i = first; i < first + n; ++i)
+      for (int k = 0; k < 3; ++k) {
+        box[k] = std::min(box[k], xyz_[3 * i + k]);
+        box[3 + k] = std::max(box[3 + k], xyz_[3 * i + k]);
+      }
+    dt_ = make_triangulator(params_.threads, box);
+  }
+  Stopwatch sw;
+  progress.stage(SC_STAGE_DELAUNAY);
+  dt_->insert(xyz_, first, n, progress);
+  seconds_[SC_STAGE_DELAUNAY] += sw.lap();
+}
+
+void Recon::add(const double *xyz, size_t n) {
+  Stopwatch sw;
+  if (n > kMaxPoints - n_)
+    throw Error(SC_ETOO_MANY_POINTS, sc_strerror(SC_ETOO_MANY_POINTS));
+  check_finite(xyz, n, n_);
+  own_.insert(own_.end(), xyz, xyz + 3 * n);
+  xyz_ = own_.data();
+  size_t first = n_;
+  n_ += n;
+  seconds_[SC_STAGE_INPUT] += sw.lap();
+  insert_range(first, n);
+}
+
+void Recon::borrow(const double *xyz, size_t n) {
+  Stopwatch sw;
+  if (n > kMaxPoints)
+    throw Error(SC_ETOO_MANY_POINTS, sc_strerror(SC_ETOO_MANY_POINTS));
+  Progress progress(params_.progress, params_.progress_user);
+  progress.stage(SC_STAGE_INPUT);
+  check_finite(xyz, n, 0);
+  xyz_ = xyz;
+  n_ = n;
+  seconds_[SC_STAGE_INPUT] += sw.lap();
+  insert_range(0, n);
+}
+
+sc_mesh_t *Recon::finish() {
+  Progress progress(params_.progress, params_.progress_user);
+  sc_diag_t diag;
+  std::memset(&diag, 0, sizeof diag);
+  diag.points_in = n_;
+
+  if (n_ < 4 || !dt_ || dt_->dimension() < 3) {
+    char buf[160];
+    int dim = dt_ ? dt_->dimension() : -1;
+    if (n_ < 4)
+      std::snprintf(buf, sizeof buf,
+                    "need at least 4 points not all coplanar, got %zu", n_);
+    else
+      std::snprintf(buf, sizeof buf, "all %zu points are %s", n_,
+                    dim <= 0   ? "the same point"
+                    : dim == 1 ? "collinear"
+                               : "coplanar");
+    throw Error(SC_EDEGENERATE_INPUT, buf);
+  }
+
+  Filtered f;
+  dt_->filter(xyz_, n_, params_, progress, f, diag, seconds_);
+  dt_.reset();
+
+  Stopwatch sw;
+  progress.stage(SC_STAGE_PRUNE);
+  std::vector<uint8_t> alive;
+  prune(xyz_, n_, f.tris, alive, progress, diag);
+  seconds_[SC_STAGE_PRUNE] += sw.lap();
+
+  progress.stage(SC_STAGE_EXTRACT);
+  Surface surf;
+  extract(xyz_, n_, f.tris, alive, progress, surf, diag);
+
+  // Per-vertex normals: the pole direction, signed to agree with the
+  // area-weighted normal of the output triangles around the vertex.
+  std::vector<double> acc(3 * n_, 0.0);
+  const size_t nt = surf.tris.size() / 3;
+  for (size_t t = 0; t < nt; ++t) {
+    const uint32_t *v = &surf.tris[3 * t];
+    const double *a = xyz_ + 3 * size_t(v[0]), *b = xyz_ + 3 * size_t(v[1]),
+                 *c = xyz_ + 3 * size_t(v[2]);
+    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double nrm[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                     u[0] * w[1] - u[1] * w[0]};
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j)
+        acc[3 * size_t(v[k]) + j] += nrm[j];
+  }
+  for (size_t i = 0; i < n_; ++i) {
+    double *a = &acc[3 * i];
+    const double *p = &f.poles[3 * i];
+    double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (!(la > 0))
+      continue; // not a vertex of the output: the normal stays zero
+    double d = a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
+    if (std::fabs(d) > 1e-3 * la) {
+      double s = d > 0 ? 1.0 : -1.0;
+      a[0] = s * p[0], a[1] = s * p[1], a[2] = s * p[2];
+    } else {
+      a[0] /= la, a[1] /= la, a[2] /= la;
+    }
+  }
+  for (auto &d : f.dups)
+    for (int j = 0; j < 3; ++j)
+      acc[3 * size_t(d.first) + j] = acc[3 * size_t(d.second) + j];
+  seconds_[SC_STAGE_EXTRACT] += sw.lap();
+
+  for (int s = 0; s < SC_STAGE_COUNT; ++s) {
+    diag.seconds[s] = seconds_[s];
+    diag.seconds_total += seconds_[s];
+  }
+  progress.report(1.0);
+
+  sc_mesh_t *m = static_cast<sc_mesh_t *>(std::calloc(1, sizeof *m));
+  if (!m)
+    throw std::bad_alloc();
+  try {
+    m->triangles = copy_out(surf.tris.data(), surf.tris.size());
+    m->triangle_count = nt;
+    m->normals = copy_out(acc.data(), acc.size());
+    m->point_count = n_;
+    m->component_genus =
+        copy_out(surf.component_genus.data(), surf.component_genus.size());
+    m->component_count = surf.component_genus.size();
+    m->diag = diag;
+  } catch (...) {
+    sc_mesh_free(m);
+    throw;
+  }
+  return m;
+}
+
+} // namespace sc

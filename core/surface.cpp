@@ -1,0 +1,533 @@
+// Sharp-edge pruning and manifold extraction over the candidate triangles.
+// Nothing here needs the Delaunay triangulation: only the points and the
+// candidates, so the triangulation is freed before these stages run.
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+
+#include "internal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace sc {
+namespace {
+
+inline uint64_t edge_key(uint32_t a, uint32_t b) {
+  return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
+}
+inline uint32_t key_lo(uint64_t k) { return uint32_t(k >> 32); }
+
+// Every candidate edge with its triangles in the cyclic order in which they
+// appear when rotating about the edge, right-handed about the direction from
+// its smaller to its larger vertex index.
+struct EdgeTable {
+  struct Entry {
+    uint64_t key;
+    double angle;
+    uint32_t tri;
+  };
+  std::vector<Entry> entries;   // grouped by edge, each group by angle
+  std::vector<uint32_t> first;  // edge id -> first entry; one extra at end
+  std::vector<uint32_t> tri_edge; // 3 per triangle: edge (v[k], v[k+1])
+
+  size_t edges() const { return first.size() - 1; }
+
+  void build(const double *xyz, size_t n, const std::vector<uint32_t> &tris,
+             Progress &progress) {
+    const size_t nt = tris.size() / 3;
+    // Bucket the entries by their smaller vertex (a counting sort), then
+    // sort each small bucket: linear overall, unlike one global sort.
+    std::vector<uint32_t> count(n + 1, 0);
+    for (size_t i = 0; i < 3 * nt; ++i) {
+      uint32_t a = tris[i], b = tris[i % 3 == 2 ? i - 2 : i + 1];
+      ++count[std::min(a, b) + 1];
+    }
+    for (size_t v = 0; v < n; ++v)
+      count[v + 1] += count[v];
+    entries.resize(3 * nt);
+    std::vector<uint32_t> fill(count.begin(), count.end() - 1);
+    for (size_t t = 0; t < nt; ++t) {
+      progress.tick(t, 2 * nt);
+      for (int k = 0; k < 3; ++k) {
+        uint32_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3],
+                 c = tris[3 * t + (k + 2) % 3];
+        uint32_t lo = std::min(a, b), hi = std::max(a, b);
+        entries[fill[lo]++] = {edge_key(a, b), angle(xyz, lo, hi, c),
+                               uint32_t(t)};
+      }
+    }
+    for (size_t v = 0; v < n; ++v)
+      std::sort(entries.begin() + count[v], entries.begin() + count[v + 1],
+                [](const Entry &x, const Entry &y) {
+                  return x.key != y.key ? x.key < y.key : x.angle < y.angle;
+                });
+    first.clear();
+    tri_edge.assign(3 * nt, 0);
+    for (size_t i = 0; i < entries.size(); ++i) {
+      progress.tick(nt + i / 3, 2 * nt);
+      if (i == 0 || entries[i].key != entries[i - 1].key)
+        first.push_back(uint32_t(i));
+      uint32_t e = uint32_t(first.size() - 1), t = entries[i].tri;
+      for (int k = 0; k < 3; ++k)
+        if (edge_key(tris[3 * t + k], tris[3 * t + (k + 1) % 3]) ==
+            entries[i].key)
+          tri_edge[3 * t + k] = e;
+    }
+    first.push_back(uint32_t(entries.size()));
+  }
+
+  // Angle of the half-plane through edge lo-hi that contains point c.
+  static double angle(const double *xyz, uint32_t lo, uint32_t hi,
+                      uint32_t c) {
+    const double *a = xyz + 3 * size_t(lo), *b = xyz + 3 * size_t(hi),
+                 *p = xyz + 3 * size_t(c);
+    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double lu = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    u[0] /= lu, u[1] /= lu, u[2] /= lu;
+    // A reference direction perpendicular to u, from the coordinate axis
+    // least aligned with it; any fixed choice works as long as it is the
+    // same for every triangle on the edge.
+    int m = std::fabs(u[0]) <= std::fabs(u[1])
+                ? (std::fabs(u[0]) <= std::fabs(u[2]) ? 0 : 2)
+                : (std::fabs(u[1]) <= std::fabs(u[2]) ? 1 : 2);
+    double ax[3] = {0, 0, 0};
+    ax[m] = 1;
+    double e1[3] = {u[1] * ax[2] - u[2] * ax[1], u[2] * ax[0] - u[0] * ax[2],
+                    u[0] * ax[1] - u[1] * ax[0]};
+    double l1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    e1[0] /= l1, e1[1] /= l1, e1[2] /= l1;
+    double e2[3] = {u[1] * e1[2] - u[2] * e1[1], u[2] * e1[0] - u[0] * e1[2],
+                    u[0] * e1[1] - u[1] * e1[0]};
+    double w[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+    return std::atan2(w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2],
+                      w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2]);
+  }
+};
+
+// An edge is sharp when its live triangles fit in a wedge narrower than
+// pi/2 (a gap between consecutive ones exceeds 3 pi/2), or when it has
+// exactly one.
+bool is_sharp(const EdgeTable &et, uint32_t e,
+              const std::vector<uint8_t> &alive) {
+  int k = 0;
+  double first = 0, prev = 0, gap = 0;
+  for (uint32_t i = et.first[e]; i < et.first[e + 1]; ++i) {
+    if (!alive[et.entries[i].tri])
+      continue;
+    double a = et.entries[i].angle;
+    if (k == 0)
+      first = a;
+    else
+      gap = std::max(gap, a - prev);
+    prev = a;
+    ++k;
+  }
+  if (k == 0)
+    return false;
+  if (k == 1)
+    return true;
+  gap = std::max(gap, 2 * M_PI - (prev - first));
+  return gap > 1.5 * M_PI;
+}
+
+struct UnionFind {
+  std::vector<uint32_t> parent;
+  explicit UnionFind(size_t n) : parent(n) {
+    std::iota(parent.begin(), parent.end(), 0u);
+  }
+  uint32_t find(uint32_t x) {
+    while (parent[x] != x)
+      x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(uint32_t a, uint32_t b) {
+    a = find(a), b = find(b);
+    if (a != b)
+      parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+// Vertex -> incident triangles, over the triangles that `keep` accepts.
+struct VertexStar {
+  std::vector<uint32_t> first, tris;
+  template <class Keep>
+  void build(size_t n, const std::vector<uint32_t> &t, Keep keep) {
+    first.assign(n + 1, 0);
+    const size_t nt = t.size() / 3;
+    for (size_t i = 0; i < nt; ++i)
+      if (keep(i))
+        for (int k = 0; k < 3; ++k)
+          ++first[t[3 * i + k] + 1];
+    for (size_t v = 0; v < n; ++v)
+      first[v + 1] += first[v];
+    tris.resize(first[n]);
+    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+    for (size_t i = 0; i < nt; ++i)
+      if (keep(i))
+        for (int k = 0; k < 3; ++k)
+          tris[fill[t[3 * i + k]]++] = uint32_t(i);
+  }
+};
+
+// The fans of triangles around vertex v: connected pieces of its link.
+// Writes a fan number per incident triangle into fan_of (same order as the
+// star's list) and returns the number of fans.
+int count_fans(uint32_t v, const std::vector<uint32_t> &star,
+               const std::vector<uint32_t> &tris, std::vector<int> &fan_of) {
+  const size_t m = star.size();
+  fan_of.assign(m, -1);
+  // Triangles around v are adjacent when they share an edge at v, that is
+  // one of their two other vertices. Stars are small: quadratic is fine.
+  std::vector<uint32_t> other(2 * m);
+  for (size_t i = 0; i < m; ++i) {
+    const uint32_t *t = &tris[3 * size_t(star[i])];
+    int j = 0;
+    for (int k = 0; k < 3; ++k)
+      if (t[k] != v)
+        other[2 * i + j++] = t[k];
+  }
+  int fans = 0;
+  std::vector<size_t> stack;
+  for (size_t s = 0; s < m; ++s) {
+    if (fan_of[s] >= 0)
+      continue;
+    fan_of[s] = fans;
+    stack.assign(1, s);
+    while (!stack.empty()) {
+      size_t i = stack.back();
+      stack.pop_back();
+      for (size_t j = 0; j < m; ++j) {
+        if (fan_of[j] >= 0)
+          continue;
+        if (other[2 * i] == other[2 * j] || other[2 * i] == other[2 * j + 1] ||
+            other[2 * i + 1] == other[2 * j] ||
+            other[2 * i + 1] == other[2 * j + 1]) {
+          fan_of[j] = fans;
+          stack.push_back(j);
+        }
+      }
+    }
+    ++fans;
+  }
+  return fans;
+}
+
+double signed_volume6(const double *xyz, const uint32_t *t, const double *o) {
+  const double *a = xyz + 3 * size_t(t[0]), *b = xyz + 3 * size_t(t[1]),
+               *c = xyz + 3 * size_t(t[2]);
+  double p[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
+  double q[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
+  double r[3] = {c[0] - o[0], c[1] - o[1], c[2] - o[2]};
+  return p[0] * (q[1] * r[2] - q[2] * r[1]) -
+         p[1] * (q[0] * r[2] - q[2] * r[0]) +
+         p[2] * (q[0] * r[1] - q[1] * r[0]);
+}
+
+} // namespace
+
+void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
+           std::vector<uint8_t> &alive, Progress &progress, sc_diag_t &diag) {
+  EdgeTable et;
+  et.build(xyz, n, cand, progress);
+  const size_t ne = et.edges();
+  alive.assign(cand.size() / 3, 1);
+  std::vector<uint32_t> work(ne);
+  std::iota(work.begin(), work.end(), 0u);
+  std::vector<uint8_t> queued(ne, 1);
+  size_t steps = 0;
+  while (!work.empty()) {
+    progress.tick(++steps, ne + diag.pruned);
+    uint32_t e = work.back();
+    work.pop_back();
+    queued[e] = 0;
+    if (!is_sharp(et, e, alive))
+      continue;
+    for (uint32_t i = et.first[e]; i < et.first[e + 1]; ++i) {
+      uint32_t t = et.entries[i].tri;
+      if (!alive[t])
+        continue;
+      alive[t] = 0;
+      ++diag.pruned;
+      for (int k = 0; k < 3; ++k) {
+        uint32_t f = et.tri_edge[3 * size_t(t) + k];
+        if (f != e && !queued[f]) {
+          queued[f] = 1;
+          work.push_back(f);
+        }
+      }
+    }
+  }
+}
+
+void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
+             const std::vector<uint8_t> &alive, Progress &progress,
+             Surface &out, sc_diag_t &diag) {
+  const size_t nt = cand.size() / 3;
+  // Only the survivors of pruning take part.
+  std::vector<uint32_t> live;
+  for (size_t t = 0; t < nt; ++t)
+    if (alive[t])
+      live.insert(live.end(), &cand[3 * t], &cand[3 * t] + 3);
+  const size_t nl = live.size() / 3;
+  EdgeTable et;
+  et.build(xyz, n, live, progress);
+  VertexStar star;
+  star.build(n, live, [](size_t) { return true; });
+
+  // The walk: grow each component from a seed triangle, crossing every edge
+  // to the first triangle met when rotating about it from the outer side.
+  // A triangle joins only if it keeps every directed edge used at most once
+  // (edge-manifold, consistently oriented) and touches no vertex of an
+  // earlier component.
+  std::vector<uint32_t> otri(live); // oriented copy
+  std::vector<uint8_t> in(nl, 0), used(et.edges(), 0);
+  std::vector<int32_t> owner(n, -1);
+  auto dir_bit = [](uint32_t a, uint32_t b) -> uint8_t {
+    return a < b ? 1 : 2;
+  };
+  auto try_add = [&](uint32_t t, uint32_t a, uint32_t b, uint32_t c,
+                     int32_t comp) {
+    const uint32_t v[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) {
+      if (owner[v[k]] != -1 && owner[v[k]] != comp)
+        return false;
+    }
+    uint32_t e[3];
+    for (int k = 0; k < 3; ++k) {
+      uint32_t x = v[k], y = v[(k + 1) % 3];
+      // Find this edge's id among the triangle's edges.
+      e[k] = UINT32_MAX;
+      for (int j = 0; j < 3; ++j)
+        if (edge_key(live[3 * t + j], live[3 * t + (j + 1) % 3]) ==
+            edge_key(x, y))
+          e[k] = et.tri_edge[3 * size_t(t) + j];
+      if (used[e[k]] & dir_bit(x, y))
+        return false;
+    }
+    for (int k = 0; k < 3; ++k) {
+      used[e[k]] |= dir_bit(v[k], v[(k + 1) % 3]);
+      owner[v[k]] = comp;
+      otri[3 * size_t(t) + k] = v[k];
+    }
+    in[t] = 1;
+    return true;
+  };
+
+  std::vector<uint32_t> order;
+  for (uint32_t v = 0; v < n; ++v)
+    if (star.first[v + 1] > star.first[v])
+      order.push_back(v);
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return xyz[3 * size_t(a)] > xyz[3 * size_t(b)];
+  });
+
+  int32_t comps = 0;
+  size_t added = 0;
+  std::vector<uint32_t> queue;
+  for (uint32_t s : order) {
+    if (owner[s] != -1)
+      continue;
+    // Seed: at the extreme vertex of what is left, the triangle whose
+    // normal is closest to +x, oriented to face +x (outward there).
+    uint32_t best = UINT32_MAX;
+    double best_nx = -1, sign = 1;
+    for (uint32_t i = star.first[s]; i < star.first[s + 1]; ++i) {
+      uint32_t t = star.tris[i];
+      const uint32_t *v = &live[3 * size_t(t)];
+      if (in[t] || owner[v[0]] != -1 || owner[v[1]] != -1 ||
+          owner[v[2]] != -1)
+        continue;
+      const double *a = xyz + 3 * size_t(v[0]), *b = xyz + 3 * size_t(v[1]),
+                   *c = xyz + 3 * size_t(v[2]);
+      double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      double nx = u[1] * w[2] - u[2] * w[1], ny = u[2] * w[0] - u[0] * w[2],
+             nz = u[0] * w[1] - u[1] * w[0];
+      double l = std::sqrt(nx * nx + ny * ny + nz * nz);
+      if (!(l > 0))
+        continue;
+      if (std::fabs(nx) / l > best_nx) {
+        best_nx = std::fabs(nx) / l;
+        best = t;
+        sign = nx >= 0 ? 1 : -1;
+      }
+    }
+    if (best == UINT32_MAX)
+      continue;
+    const uint32_t *v = &live[3 * size_t(best)];
+    bool ok = sign > 0 ? try_add(best, v[0], v[1], v[2], comps)
+                       : try_add(best, v[0], v[2], v[1], comps);
+    if (!ok)
+      continue;
+    queue.assign(1, best);
+    while (!queue.empty()) {
+      progress.tick(++added, nl);
+      uint32_t t = queue.back();
+      queue.pop_back();
+      for (int k = 0; k < 3; ++k) {
+        uint32_t x = otri[3 * size_t(t) + k], y = otri[3 * size_t(t) + (k + 1) % 3];
+        uint32_t e = UINT32_MAX;
+        for (int j = 0; j < 3; ++j)
+          if (edge_key(live[3 * size_t(t) + j], live[3 * size_t(t) + (j + 1) % 3]) ==
+              edge_key(x, y))
+            e = et.tri_edge[3 * size_t(t) + j];
+        uint32_t lo = et.first[e], cnt = et.first[e + 1] - lo;
+        if (cnt < 2)
+          continue;
+        uint32_t pos = 0;
+        while (et.entries[lo + pos].tri != t)
+          ++pos;
+        // Rotating toward the outer side of t is increasing angle when t
+        // runs along the edge's reference direction, decreasing otherwise.
+        uint32_t step = x < y ? 1 : cnt - 1;
+        uint32_t nb = et.entries[lo + (pos + step) % cnt].tri;
+        if (in[nb])
+          continue;
+        const uint32_t *w = &live[3 * size_t(nb)];
+        uint32_t z = w[0] != x && w[0] != y ? w[0] : w[1] != x && w[1] != y ? w[1] : w[2];
+        if (try_add(nb, y, x, z, comps))
+          queue.push_back(nb);
+      }
+    }
+    ++comps;
+  }
+
+  // A vertex whose triangles form several fans is pinched: keep its largest
+  // fan. Removing triangles can pinch their other vertices, so repeat until
+  // every vertex has one fan.
+  VertexStar ostar;
+  ostar.build(n, otri, [&](size_t t) { return in[t] != 0; });
+  std::vector<uint32_t> work;
+  for (uint32_t v = 0; v < n; ++v)
+    if (ostar.first[v + 1] > ostar.first[v])
+      work.push_back(v);
+  std::vector<uint32_t> cur;
+  std::vector<int> fan_of;
+  while (!work.empty()) {
+    uint32_t v = work.back();
+    work.pop_back();
+    cur.clear();
+    for (uint32_t i = ostar.first[v]; i < ostar.first[v + 1]; ++i)
+      if (in[ostar.tris[i]])
+        cur.push_back(ostar.tris[i]);
+    int fans = count_fans(v, cur, otri, fan_of);
+    if (fans <= 1)
+      continue;
+    std::vector<size_t> size(fans, 0);
+    for (int f : fan_of)
+      ++size[f];
+    int keep = int(std::max_element(size.begin(), size.end()) - size.begin());
+    for (size_t i = 0; i < cur.size(); ++i) {
+      if (fan_of[i] == keep)
+        continue;
+      in[cur[i]] = 0;
+      for (int k = 0; k < 3; ++k)
+        if (otri[3 * size_t(cur[i]) + k] != v)
+          work.push_back(otri[3 * size_t(cur[i]) + k]);
+    }
+  }
+
+  // The output, its components (triangles sharing an edge), and their
+  // topology. Closed components facing inward are flipped.
+  std::vector<uint32_t> res;
+  for (size_t t = 0; t < nl; ++t)
+    if (in[t])
+      res.insert(res.end(), &otri[3 * t], &otri[3 * t] + 3);
+  const size_t nr = res.size() / 3;
+  EdgeTable rt;
+  rt.build(xyz, n, res, progress);
+  UnionFind uf(nr);
+  for (size_t e = 0; e < rt.edges(); ++e)
+    for (uint32_t i = rt.first[e] + 1; i < rt.first[e + 1]; ++i)
+      uf.unite(rt.entries[rt.first[e]].tri, rt.entries[i].tri);
+  std::vector<int32_t> comp_of(nr, -1), root_comp(nr, -1);
+  int32_t nc = 0;
+  for (size_t t = 0; t < nr; ++t) {
+    uint32_t r = uf.find(uint32_t(t));
+    if (root_comp[r] < 0)
+      root_comp[r] = nc++;
+    comp_of[t] = root_comp[r];
+  }
+  std::vector<int64_t> F(nc, 0), E(nc, 0), V(nc, 0), B(nc, 0), L(nc, 0);
+  std::vector<double> vol(nc, 0.0);
+  for (size_t t = 0; t < nr; ++t)
+    ++F[comp_of[t]];
+  UnionFind bloops(n);
+  std::vector<uint8_t> on_boundary(n, 0);
+  for (size_t e = 0; e < rt.edges(); ++e) {
+    uint32_t cnt = rt.first[e + 1] - rt.first[e];
+    int32_t c = comp_of[rt.entries[rt.first[e]].tri];
+    ++E[c];
+    if (cnt == 1) {
+      ++B[c];
+      ++diag.boundary_edges;
+      uint64_t k = rt.entries[rt.first[e]].key;
+      bloops.unite(key_lo(k), uint32_t(k));
+      on_boundary[key_lo(k)] = on_boundary[uint32_t(k)] = 1;
+    } else if (cnt > 2) {
+      ++diag.nonmanifold_edges;
+    }
+  }
+  std::vector<int32_t> vcomp(n, -1);
+  for (size_t t = 0; t < nr; ++t)
+    for (int k = 0; k < 3; ++k)
+      vcomp[res[3 * t + k]] = comp_of[t];
+  size_t used_vertices = 0;
+  for (uint32_t v = 0; v < n; ++v) {
+    if (vcomp[v] < 0)
+      continue;
+    ++used_vertices;
+    ++V[vcomp[v]];
+    if (on_boundary[v] && bloops.find(v) == v)
+      ++L[vcomp[v]];
+  }
+  // Signed volumes about each component's first vertex, for precision.
+  std::vector<uint32_t> origin(nc, UINT32_MAX);
+  for (size_t t = 0; t < nr; ++t) {
+    int32_t c = comp_of[t];
+    if (origin[c] == UINT32_MAX)
+      origin[c] = res[3 * t];
+    vol[c] += signed_volume6(xyz, &res[3 * t], xyz + 3 * size_t(origin[c]));
+  }
+  for (size_t t = 0; t < nr; ++t) {
+    int32_t c = comp_of[t];
+    if (B[c] == 0 && vol[c] < 0)
+      std::swap(res[3 * t + 1], res[3 * t + 2]);
+  }
+
+  // A final check of vertex-manifoldness on the result, counted honestly.
+  VertexStar fstar;
+  fstar.build(n, res, [](size_t) { return true; });
+  for (uint32_t v = 0; v < n; ++v) {
+    if (fstar.first[v + 1] == fstar.first[v])
+      continue;
+    cur.assign(fstar.tris.begin() + fstar.first[v],
+               fstar.tris.begin() + fstar.first[v + 1]);
+    if (count_fans(v, cur, res, fan_of) > 1)
+      ++diag.nonmanifold_vertices;
+  }
+
+  out.component_genus.assign(nc, -1);
+  diag.euler = 0;
+  diag.genus = 0;
+  for (int32_t c = 0; c < nc; ++c) {
+    int64_t chi = V[c] - E[c] + F[c];
+    diag.euler += chi;
+    if (B[c] == 0) {
+      ++diag.closed_components;
+      out.component_genus[c] = int32_t((2 - chi) / 2);
+      diag.genus += (2 - chi) / 2;
+    }
+    diag.boundary_loops += L[c];
+  }
+  diag.components = nc;
+  diag.triangles = nr;
+  diag.walk_rejected = nl - nr;
+  diag.closed = nr > 0 && diag.boundary_edges == 0;
+  uint64_t distinct = diag.delaunay_vertices;
+  diag.samples_unused = distinct > used_vertices ? distinct - used_vertices : 0;
+  out.tris.swap(res);
+}
+
+} // namespace sc
