@@ -53,6 +53,8 @@ extern "C" void sc_params_init(sc_params_t *p) {
   p->mode = SC_MODE_COCONE;
   p->r = 0.25;
   p->cocone_theta = M_PI / 8;
+  p->paper_pruning = 0;
+  p->max_hole_edges = 100;
   p->threads = 1;
 }
 
@@ -79,6 +81,15 @@ int check_params(const sc_params_t *p, char *msg, size_t len) {
   if (!(p->cocone_theta > 0 && p->cocone_theta < M_PI / 2)) {
     set_msg(msg, len, "cocone_theta must be in (0, pi/2), got %g",
             p->cocone_theta);
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (p->paper_pruning != 0 && p->paper_pruning != 1) {
+    set_msg(msg, len, "paper_pruning must be 0 or 1, got %d", p->paper_pruning);
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (p->max_hole_edges < 0 || p->max_hole_edges > 100000) {
+    set_msg(msg, len, "max_hole_edges must be in [0, 100000], got %d",
+            p->max_hole_edges);
     return SC_EINVALID_ARGUMENT;
   }
   if (p->threads < 0) {

@@ -91,10 +91,11 @@ struct Surface {
   std::vector<int32_t> component_genus;
 };
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
-           std::vector<uint8_t> &alive, Progress &progress, sc_diag_t &diag);
+           bool erode_single, std::vector<uint8_t> &alive, Progress &progress,
+           sc_diag_t &diag);
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
-             const std::vector<uint8_t> &alive, Progress &progress,
-             Surface &out, sc_diag_t &diag);
+             const std::vector<uint8_t> &alive, size_t max_hole,
+             Progress &progress, Surface &out, sc_diag_t &diag);
 
 // One reconstruction, fed all at once or in chunks.
 class Recon {

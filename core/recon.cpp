@@ -119,12 +119,13 @@ sc_mesh_t *Recon::finish() {
   Stopwatch sw;
   progress.stage(SC_STAGE_PRUNE);
   std::vector<uint8_t> alive;
-  prune(xyz_, n_, f.tris, alive, progress, diag);
+  prune(xyz_, n_, f.tris, params_.paper_pruning != 0, alive, progress, diag);
   seconds_[SC_STAGE_PRUNE] += sw.lap();
 
   progress.stage(SC_STAGE_EXTRACT);
   Surface surf;
-  extract(xyz_, n_, f.tris, alive, progress, surf, diag);
+  extract(xyz_, n_, f.tris, alive, size_t(params_.max_hole_edges), progress,
+          surf, diag);
 
   // Per-vertex normals: the pole direction, signed to agree with the
   // area-weighted normal of the output triangles around the vertex.

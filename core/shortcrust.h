@@ -94,8 +94,18 @@ typedef struct sc_params {
    * in (0, pi/2). Default pi/8: the cocone is |cos angle(y - s, pole)| <=
    * cos(pi/2 - theta). */
   double cocone_theta;
-  /* Worker threads for the Delaunay triangulation and the candidate pass;
-   * 0 means one per core. Default 1. */
+  /* Edges with a single candidate triangle. 0 (default): such an edge is
+   * sharp only when its triangle hangs by it alone (two or more of its edges
+   * have no other candidate), so fins go but a hole left by a missing
+   * triangle stays small. 1: every such edge is sharp, exactly as in the
+   * paper; one missing triangle then erodes the whole surface. */
+  int paper_pruning;
+  /* Holes whose boundary loop has at most this many edges are closed after
+   * extraction by a least-area triangulation of the loop; 0 disables. In
+   * [0, 100000]. Default 100. */
+  int max_hole_edges;
+  /* Threads for the Delaunay triangulation; 0 means one per core.
+   * Default 1. */
   int threads;
   /* Optional progress and cancellation; NULL for none. */
   sc_progress_fn progress;
@@ -118,6 +128,8 @@ typedef struct sc_diag {
   uint64_t pruned;             /* candidates removed for a sharp edge */
   uint64_t triangles;          /* triangles in the output */
   uint64_t walk_rejected;      /* survivors of pruning left out by the walk */
+  uint64_t holes_filled;       /* small holes closed after the walk */
+  uint64_t hole_triangles;     /* triangles added to close them */
   uint64_t samples_unused;     /* distinct samples in no output triangle */
   uint64_t boundary_edges;     /* output edges with a single triangle */
   uint64_t boundary_loops;     /* closed loops of boundary edges */

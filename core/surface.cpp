@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace sc {
@@ -109,7 +110,7 @@ struct EdgeTable {
 // pi/2 (a gap between consecutive ones exceeds 3 pi/2), or when it has
 // exactly one.
 bool is_sharp(const EdgeTable &et, uint32_t e,
-              const std::vector<uint8_t> &alive) {
+              const std::vector<uint8_t> &alive, bool erode_single) {
   int k = 0;
   double first = 0, prev = 0, gap = 0;
   for (uint32_t i = et.first[e]; i < et.first[e + 1]; ++i) {
@@ -126,7 +127,7 @@ bool is_sharp(const EdgeTable &et, uint32_t e,
   if (k == 0)
     return false;
   if (k == 1)
-    return true;
+    return erode_single;
   gap = std::max(gap, 2 * M_PI - (prev - first));
   return gap > 1.5 * M_PI;
 }
@@ -224,10 +225,122 @@ double signed_volume6(const double *xyz, const uint32_t *t, const double *o) {
          p[2] * (q[0] * r[1] - q[1] * r[0]);
 }
 
+// Closes the holes of an edge-manifold, consistently oriented, vertex-
+// manifold surface whose boundary loops have at most max_loop edges. Each
+// hole is triangulated over its own loop by dynamic programming for the
+// least total area, never creating an edge the surface already has, so the
+// result stays a manifold.
+void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
+                size_t max_loop, Progress &progress, sc_diag_t &diag) {
+  EdgeTable et;
+  et.build(xyz, n, res, progress);
+  auto has_edge = [&](uint32_t a, uint32_t b) {
+    uint64_t k = edge_key(a, b);
+    auto it = std::lower_bound(
+        et.entries.begin(), et.entries.end(), k,
+        [](const EdgeTable::Entry &x, uint64_t key) { return x.key < key; });
+    return it != et.entries.end() && it->key == k;
+  };
+  // The hole runs against the orientation of the triangle on each boundary
+  // edge: a triangle with x -> y leaves the hole edge y -> x.
+  std::vector<uint32_t> next(n, UINT32_MAX);
+  std::vector<uint8_t> bad(n, 0);
+  for (size_t e = 0; e < et.edges(); ++e) {
+    if (et.first[e + 1] - et.first[e] != 1)
+      continue;
+    const EdgeTable::Entry &en = et.entries[et.first[e]];
+    const uint32_t *t = &res[3 * size_t(en.tri)];
+    for (int k = 0; k < 3; ++k) {
+      uint32_t x = t[k], y = t[(k + 1) % 3];
+      if (edge_key(x, y) != en.key)
+        continue;
+      if (next[y] != UINT32_MAX)
+        bad[y] = 1;
+      next[y] = x;
+    }
+  }
+  std::vector<uint32_t> loop;
+  std::vector<double> cost;
+  std::vector<uint32_t> split;
+  std::vector<uint8_t> seen(n, 0);
+  for (uint32_t v0 = 0; v0 < n; ++v0) {
+    if (next[v0] == UINT32_MAX || seen[v0])
+      continue;
+    loop.clear();
+    bool ok = true;
+    uint32_t v = v0;
+    while (!seen[v]) {
+      seen[v] = 1;
+      ok = ok && !bad[v];
+      loop.push_back(v);
+      v = next[v];
+      if (v == UINT32_MAX) {
+        ok = false;
+        break;
+      }
+    }
+    if (!ok || v != v0 || loop.size() < 3 || loop.size() > max_loop)
+      continue;
+    const size_t L = loop.size();
+    auto area = [&](size_t i, size_t k, size_t j) {
+      const double *a = xyz + 3 * size_t(loop[i]), *b = xyz + 3 * size_t(loop[k]),
+                   *c = xyz + 3 * size_t(loop[j]);
+      double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      double x = u[1] * w[2] - u[2] * w[1], y = u[2] * w[0] - u[0] * w[2],
+             z = u[0] * w[1] - u[1] * w[0];
+      return std::sqrt(x * x + y * y + z * z);
+    };
+    const double inf = std::numeric_limits<double>::infinity();
+    cost.assign(L * L, inf);
+    split.assign(L * L, UINT32_MAX);
+    for (size_t i = 0; i + 1 < L; ++i)
+      cost[i * L + i + 1] = 0;
+    for (size_t len = 2; len < L; ++len) {
+      for (size_t i = 0; i + len < L; ++i) {
+        size_t j = i + len;
+        // (0, L-1) is a loop edge; any other chord must be a new edge.
+        if (!(i == 0 && j == L - 1) && has_edge(loop[i], loop[j]))
+          continue;
+        for (size_t k = i + 1; k < j; ++k) {
+          double c = cost[i * L + k] + cost[k * L + j];
+          if (c == inf)
+            continue;
+          c += area(i, k, j);
+          if (c < cost[i * L + j]) {
+            cost[i * L + j] = c;
+            split[i * L + j] = uint32_t(k);
+          }
+        }
+      }
+    }
+    if (cost[L - 1] == inf)
+      continue;
+    std::vector<std::pair<size_t, size_t>> stack{{0, L - 1}};
+    size_t added = 0;
+    while (!stack.empty()) {
+      auto [i, j] = stack.back();
+      stack.pop_back();
+      if (j - i < 2)
+        continue;
+      size_t k = split[i * L + j];
+      res.push_back(loop[i]);
+      res.push_back(loop[k]);
+      res.push_back(loop[j]);
+      ++added;
+      stack.push_back({i, k});
+      stack.push_back({k, j});
+    }
+    ++diag.holes_filled;
+    diag.hole_triangles += added;
+  }
+}
+
 } // namespace
 
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
-           std::vector<uint8_t> &alive, Progress &progress, sc_diag_t &diag) {
+           bool erode_single, std::vector<uint8_t> &alive, Progress &progress,
+           sc_diag_t &diag) {
   EdgeTable et;
   et.build(xyz, n, cand, progress);
   const size_t ne = et.edges();
@@ -235,14 +348,38 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   std::vector<uint32_t> work(ne);
   std::iota(work.begin(), work.end(), 0u);
   std::vector<uint8_t> queued(ne, 1);
+  auto live_on = [&](uint32_t e) {
+    uint32_t k = 0;
+    for (uint32_t i = et.first[e]; i < et.first[e + 1]; ++i)
+      k += alive[et.entries[i].tri];
+    return k;
+  };
+  // Without erosion, a lone triangle on an edge goes only when it hangs by
+  // at most one edge: a fin, not the rim of a hole.
+  auto dangling = [&](uint32_t e) {
+    if (live_on(e) != 1)
+      return false;
+    for (uint32_t i = et.first[e]; i < et.first[e + 1]; ++i) {
+      uint32_t t = et.entries[i].tri;
+      if (!alive[t])
+        continue;
+      int lone = 0;
+      for (int k = 0; k < 3; ++k)
+        lone += live_on(et.tri_edge[3 * size_t(t) + k]) == 1;
+      return lone >= 2;
+    }
+    return false;
+  };
   size_t steps = 0;
   while (!work.empty()) {
     progress.tick(++steps, ne + diag.pruned);
     uint32_t e = work.back();
     work.pop_back();
     queued[e] = 0;
-    if (!is_sharp(et, e, alive))
-      continue;
+    if (!is_sharp(et, e, alive, erode_single)) {
+      if (erode_single || !dangling(e))
+        continue;
+    }
     for (uint32_t i = et.first[e]; i < et.first[e + 1]; ++i) {
       uint32_t t = et.entries[i].tri;
       if (!alive[t])
@@ -261,8 +398,8 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 }
 
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
-             const std::vector<uint8_t> &alive, Progress &progress,
-             Surface &out, sc_diag_t &diag) {
+             const std::vector<uint8_t> &alive, size_t max_hole,
+             Progress &progress, Surface &out, sc_diag_t &diag) {
   const size_t nt = cand.size() / 3;
   // Only the survivors of pruning take part.
   std::vector<uint32_t> live;
@@ -283,6 +420,15 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   std::vector<uint32_t> otri(live); // oriented copy
   std::vector<uint8_t> in(nl, 0), used(et.edges(), 0);
   std::vector<int32_t> owner(n, -1);
+  // The id of the edge x-y of live triangle t.
+  auto edge_of = [&](uint32_t t, uint32_t x, uint32_t y) {
+    const uint64_t key = edge_key(x, y);
+    for (int j = 0; j < 3; ++j)
+      if (edge_key(live[3 * size_t(t) + j], live[3 * size_t(t) + (j + 1) % 3]) ==
+          key)
+        return et.tri_edge[3 * size_t(t) + j];
+    return uint32_t(UINT32_MAX);
+  };
   auto dir_bit = [](uint32_t a, uint32_t b) -> uint8_t {
     return a < b ? 1 : 2;
   };
@@ -296,12 +442,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     uint32_t e[3];
     for (int k = 0; k < 3; ++k) {
       uint32_t x = v[k], y = v[(k + 1) % 3];
-      // Find this edge's id among the triangle's edges.
-      e[k] = UINT32_MAX;
-      for (int j = 0; j < 3; ++j)
-        if (edge_key(live[3 * t + j], live[3 * t + (j + 1) % 3]) ==
-            edge_key(x, y))
-          e[k] = et.tri_edge[3 * size_t(t) + j];
+      e[k] = edge_of(t, x, y);
       if (used[e[k]] & dir_bit(x, y))
         return false;
     }
@@ -322,13 +463,81 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     return xyz[3 * size_t(a)] > xyz[3 * size_t(b)];
   });
 
-  int32_t comps = 0;
+  // A clean triangle has exactly two live triangles on each edge: the walk
+  // starts there, away from pockets of extra candidates.
+  auto clean = [&](uint32_t t) {
+    for (int j = 0; j < 3; ++j) {
+      uint32_t e = et.tri_edge[3 * size_t(t) + j];
+      if (et.first[e + 1] - et.first[e] != 2)
+        return false;
+    }
+    return true;
+  };
+
   size_t added = 0;
-  std::vector<uint32_t> queue;
+  std::vector<uint32_t> members, queue;
+  auto walk = [&](uint32_t seed, uint32_t a, uint32_t b, uint32_t c,
+                  int32_t comp) {
+    members.clear();
+    if (!try_add(seed, a, b, c, comp))
+      return;
+    members.push_back(seed);
+    queue.assign(1, seed);
+    while (!queue.empty()) {
+      progress.tick(++added, 2 * nl);
+      uint32_t t = queue.back();
+      queue.pop_back();
+      for (int k = 0; k < 3; ++k) {
+        uint32_t x = otri[3 * size_t(t) + k],
+                 y = otri[3 * size_t(t) + (k + 1) % 3];
+        uint32_t e = edge_of(t, x, y);
+        uint32_t lo = et.first[e], cnt = et.first[e + 1] - lo;
+        if (cnt < 2)
+          continue;
+        uint32_t pos = 0;
+        while (et.entries[lo + pos].tri != t)
+          ++pos;
+        // Rotating toward the outer side of t is increasing angle when t
+        // runs along the edge's reference direction, decreasing otherwise.
+        uint32_t step = x < y ? 1 : cnt - 1;
+        uint32_t nb = et.entries[lo + (pos + step) % cnt].tri;
+        if (in[nb])
+          continue;
+        const uint32_t *w = &live[3 * size_t(nb)];
+        uint32_t z = w[0] != x && w[0] != y   ? w[0]
+                     : w[1] != x && w[1] != y ? w[1]
+                                              : w[2];
+        if (try_add(nb, y, x, z, comp)) {
+          members.push_back(nb);
+          queue.push_back(nb);
+        }
+      }
+    }
+  };
+  auto undo = [&]() {
+    for (uint32_t t : members) {
+      in[t] = 0;
+      for (int k = 0; k < 3; ++k) {
+        uint32_t x = otri[3 * size_t(t) + k],
+                 y = otri[3 * size_t(t) + (k + 1) % 3];
+        used[edge_of(t, x, y)] &= uint8_t(~dir_bit(x, y));
+        owner[x] = -1;
+      }
+    }
+  };
+  auto volume = [&]() {
+    double v = 0;
+    const double *o = xyz + 3 * size_t(otri[3 * size_t(members[0])]);
+    for (uint32_t t : members)
+      v += signed_volume6(xyz, &otri[3 * size_t(t)], o);
+    return v;
+  };
+
+  int32_t comps = 0;
   for (uint32_t s : order) {
     if (owner[s] != -1)
       continue;
-    // Seed: at the extreme vertex of what is left, the triangle whose
+    // Seed: at the extreme vertex of what is left, the clean triangle whose
     // normal is closest to +x, oriented to face +x (outward there).
     uint32_t best = UINT32_MAX;
     double best_nx = -1, sign = 1;
@@ -336,7 +545,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
       uint32_t t = star.tris[i];
       const uint32_t *v = &live[3 * size_t(t)];
       if (in[t] || owner[v[0]] != -1 || owner[v[1]] != -1 ||
-          owner[v[2]] != -1)
+          owner[v[2]] != -1 || !clean(t))
         continue;
       const double *a = xyz + 3 * size_t(v[0]), *b = xyz + 3 * size_t(v[1]),
                    *c = xyz + 3 * size_t(v[2]);
@@ -356,39 +565,18 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     if (best == UINT32_MAX)
       continue;
     const uint32_t *v = &live[3 * size_t(best)];
-    bool ok = sign > 0 ? try_add(best, v[0], v[1], v[2], comps)
-                       : try_add(best, v[0], v[2], v[1], comps);
-    if (!ok)
+    uint32_t b1 = sign > 0 ? v[1] : v[2], c1 = sign > 0 ? v[2] : v[1];
+    walk(best, v[0], b1, c1, comps);
+    if (members.empty())
       continue;
-    queue.assign(1, best);
-    while (!queue.empty()) {
-      progress.tick(++added, nl);
-      uint32_t t = queue.back();
-      queue.pop_back();
-      for (int k = 0; k < 3; ++k) {
-        uint32_t x = otri[3 * size_t(t) + k], y = otri[3 * size_t(t) + (k + 1) % 3];
-        uint32_t e = UINT32_MAX;
-        for (int j = 0; j < 3; ++j)
-          if (edge_key(live[3 * size_t(t) + j], live[3 * size_t(t) + (j + 1) % 3]) ==
-              edge_key(x, y))
-            e = et.tri_edge[3 * size_t(t) + j];
-        uint32_t lo = et.first[e], cnt = et.first[e + 1] - lo;
-        if (cnt < 2)
-          continue;
-        uint32_t pos = 0;
-        while (et.entries[lo + pos].tri != t)
-          ++pos;
-        // Rotating toward the outer side of t is increasing angle when t
-        // runs along the edge's reference direction, decreasing otherwise.
-        uint32_t step = x < y ? 1 : cnt - 1;
-        uint32_t nb = et.entries[lo + (pos + step) % cnt].tri;
-        if (in[nb])
-          continue;
-        const uint32_t *w = &live[3 * size_t(nb)];
-        uint32_t z = w[0] != x && w[0] != y ? w[0] : w[1] != x && w[1] != y ? w[1] : w[2];
-        if (try_add(nb, y, x, z, comps))
-          queue.push_back(nb);
-      }
+    // The walk keeps to the outer side of its seed's orientation. If the
+    // component came out facing inward, the seed was oriented wrongly and
+    // the walk followed the inner candidates: walk again the other way.
+    if (volume() < 0) {
+      undo();
+      walk(best, v[0], c1, b1, comps);
+      if (members.empty())
+        continue;
     }
     ++comps;
   }
@@ -434,6 +622,9 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   for (size_t t = 0; t < nl; ++t)
     if (in[t])
       res.insert(res.end(), &otri[3 * t], &otri[3 * t] + 3);
+  diag.walk_rejected = nl - res.size() / 3;
+  if (max_hole >= 3)
+    fill_holes(xyz, n, res, max_hole, progress, diag);
   const size_t nr = res.size() / 3;
   EdgeTable rt;
   rt.build(xyz, n, res, progress);
@@ -523,7 +714,6 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   }
   diag.components = nc;
   diag.triangles = nr;
-  diag.walk_rejected = nl - nr;
   diag.closed = nr > 0 && diag.boundary_edges == 0;
   uint64_t distinct = diag.delaunay_vertices;
   diag.samples_unused = distinct > used_vertices ? distinct - used_vertices : 0;
