@@ -51,7 +51,7 @@ extern "C" void sc_params_init(sc_params_t *p) {
     return;
   std::memset(p, 0, sizeof *p);
   p->mode = SC_MODE_COCONE;
-  p->r = 0.25;
+  p->r = 0.18;
   p->cocone_theta = M_PI / 8;
   p->paper_pruning = 0;
   p->max_hole_edges = 100;

@@ -87,8 +87,9 @@ typedef struct sc_params {
   sc_mode_t mode;
   /* Sampling parameter of the shortcrust criteria, in (0, 0.5). The paper
    * proves its guarantees for r < 1/7; larger values accept more triangles
-   * on sparser or less even samples. Default 0.25 (see the README for the
-   * measurements behind it). Ignored by the cocone test. */
+   * on sparser or less even samples, and from about 0.2 on bridge nearby
+   * parts of a surface. Default 0.18 (see the README for the measurements
+   * behind it). Ignored by the cocone test. */
   double r;
   /* Half-width of the cocone around the plane normal to the pole, radians,
    * in (0, pi/2). Default pi/8: the cocone is |cos angle(y - s, pole)| <=

@@ -7,6 +7,7 @@
 #include "internal.hpp"
 
 #include <algorithm>
+#include <unordered_set>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -225,6 +226,21 @@ double signed_volume6(const double *xyz, const uint32_t *t, const double *o) {
          p[2] * (q[0] * r[1] - q[1] * r[0]);
 }
 
+// Whether the triangle {a, b, c} is in tris, looked up through edge ab.
+bool is_triangle_of(const EdgeTable &et, const std::vector<uint32_t> &tris,
+                    uint32_t a, uint32_t b, uint32_t c) {
+  uint64_t k = edge_key(a, b);
+  auto it = std::lower_bound(
+      et.entries.begin(), et.entries.end(), k,
+      [](const EdgeTable::Entry &x, uint64_t key) { return x.key < key; });
+  for (; it != et.entries.end() && it->key == k; ++it) {
+    const uint32_t *t = &tris[3 * size_t(it->tri)];
+    if (t[0] == c || t[1] == c || t[2] == c)
+      return true;
+  }
+  return false;
+}
+
 // Closes the holes of an edge-manifold, consistently oriented, vertex-
 // manifold surface whose boundary loops have at most max_loop edges. Each
 // hole is triangulated over its own loop by dynamic programming for the
@@ -234,12 +250,15 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
                 size_t max_loop, Progress &progress, sc_diag_t &diag) {
   EdgeTable et;
   et.build(xyz, n, res, progress);
+  // Chords added by earlier fills count as existing edges too: two holes
+  // that share vertices must not both add the same chord.
+  std::unordered_set<uint64_t> chords;
   auto has_edge = [&](uint32_t a, uint32_t b) {
     uint64_t k = edge_key(a, b);
     auto it = std::lower_bound(
         et.entries.begin(), et.entries.end(), k,
         [](const EdgeTable::Entry &x, uint64_t key) { return x.key < key; });
-    return it != et.entries.end() && it->key == k;
+    return (it != et.entries.end() && it->key == k) || chords.count(k) != 0;
   };
   // The hole runs against the orientation of the triangle on each boundary
   // edge: a triangle with x -> y leaves the hole edge y -> x.
@@ -282,6 +301,10 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     if (!ok || v != v0 || loop.size() < 3 || loop.size() > max_loop)
       continue;
     const size_t L = loop.size();
+    // A three-edge loop around a lone triangle would be closed by a second
+    // copy of that triangle.
+    if (L == 3 && is_triangle_of(et, res, loop[0], loop[1], loop[2]))
+      continue;
     auto area = [&](size_t i, size_t k, size_t j) {
       const double *a = xyz + 3 * size_t(loop[i]), *b = xyz + 3 * size_t(loop[k]),
                    *c = xyz + 3 * size_t(loop[j]);
@@ -327,6 +350,10 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
       res.push_back(loop[i]);
       res.push_back(loop[k]);
       res.push_back(loop[j]);
+      if (k - i > 1)
+        chords.insert(edge_key(loop[i], loop[k]));
+      if (j - k > 1)
+        chords.insert(edge_key(loop[k], loop[j]));
       ++added;
       stack.push_back({i, k});
       stack.push_back({k, j});
