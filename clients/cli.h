@@ -1,0 +1,87 @@
+/*
+ * Pieces shared by the subcommands of the `shortcrust` command: option
+ * values, progress on a terminal, the closing summary and the JSON report.
+ * Every subcommand that produces a mesh (local or through the daemon) prints
+ * the same summary and writes the same report, so scripts need not care
+ * which path made the mesh.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#ifndef SC_CLI_H
+#define SC_CLI_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "shortcrust.h"
+
+/* Exit codes of every subcommand. */
+enum {
+  SC_EXIT_OK = 0,      /* the job was done */
+  SC_EXIT_FAILURE = 1, /* a file, the reconstruction or the daemon failed */
+  SC_EXIT_USAGE = 2    /* the command line was wrong; nothing was done */
+};
+
+/* Prints "shortcrust: " and the formatted message to stderr. */
+void sc_cli_error(const char *fmt, ...)
+    __attribute__((format(printf, 1, 2)));
+
+/* Option values; each returns 0 or prints what is wrong and returns -1. */
+int sc_cli_parse_mode(const char *opt, const char *arg, sc_mode_t *out);
+int sc_cli_parse_double(const char *opt, const char *arg, double *out);
+int sc_cli_parse_int(const char *opt, const char *arg, long min, long max,
+                     long *out);
+
+/* The name of a mode as the --mode option spells it. */
+const char *sc_cli_mode_name(sc_mode_t mode);
+
+/*
+ * Progress on stderr, redrawn in place, when stderr is a terminal and the
+ * user did not ask for quiet; otherwise silent. Usable as an sc_progress_fn
+ * with a pointer to the struct as user data. Never cancels.
+ */
+typedef struct sc_cli_progress {
+  int enabled;
+  int last_stage;
+  double last_time;
+  int dirty; /* a line is on screen and must be cleared before other output */
+} sc_cli_progress_t;
+
+void sc_cli_progress_init(sc_cli_progress_t *p, int quiet);
+int sc_cli_progress_fn(void *user, sc_stage_t stage, double fraction);
+/* Shows an arbitrary step ("reading", "writing", "upload" ...). */
+void sc_cli_progress_step(sc_cli_progress_t *p, const char *what,
+                          double fraction);
+/* Clears the progress line, if any. */
+void sc_cli_progress_done(sc_cli_progress_t *p);
+
+/* Monotonic seconds. */
+double sc_cli_now(void);
+
+/* What a mesh-producing subcommand did, for the summary and the report. */
+typedef struct sc_cli_result {
+  const char *command; /* "reconstruct", "submit" */
+  const char *input;
+  const char *output;
+  sc_params_t params;
+  const sc_diag_t *diag;
+  const int32_t *component_genus; /* may be NULL */
+  size_t component_count;
+  double seconds_read;
+  double seconds_write;
+  double seconds_transfer; /* time on the wire for submit; 0 otherwise */
+} sc_cli_result_t;
+
+/* The closing paragraph: points, duplicates, triangles, closed or not,
+ * components, genus, time per stage. */
+void sc_cli_summary(FILE *f, const sc_cli_result_t *r);
+
+/* The diagnostics as one JSON object; malloc'd, NULL when out of memory. */
+char *sc_cli_report_json(const sc_cli_result_t *r);
+
+/* Writes the JSON report to path atomically; prints an error on failure. */
+int sc_cli_write_report(const char *path, const sc_cli_result_t *r);
+
+#endif /* SC_CLI_H */

@@ -1,0 +1,226 @@
+/*
+ * `shortcrust reconstruct`: read a point file, reconstruct here, write the
+ * mesh.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "cli_commands.h"
+#include "files.h"
+
+#define SC_PI 3.14159265358979323846
+
+static void usage(FILE *f) {
+  sc_params_t d;
+  sc_params_init(&d);
+  fprintf(
+      f,
+      "usage: shortcrust reconstruct IN -o OUT [options]\n\n"
+      "Reconstructs a triangle mesh from the points of IN and writes it to\n"
+      "OUT. IN may be .ply (ascii or binary), .xyz/.txt/.pts/.csv, .off or\n"
+      ".obj (a mesh file gives its vertices). OUT's extension picks the\n"
+      "format: .ply (binary unless --ascii), .off, .obj or .stl. Every input\n"
+      "point is written, in input order, so triangle indices refer to IN.\n\n"
+      "options:\n"
+      "  -o, --output OUT      the mesh to write (required)\n"
+      "  -m, --mode MODE       candidate test: cocone or shortcrust "
+      "(default %s)\n"
+      "      --r R             shortcrust sampling parameter, in (0, 0.5) "
+      "(default %g)\n"
+      "      --theta DEG       cocone half-width in degrees, in (0, 90) "
+      "(default %g)\n"
+      "      --max-hole N      close holes of at most N edges, 0 = never "
+      "(default %d)\n"
+      "      --paper-pruning   prune every edge with a single candidate, as "
+      "in the paper\n"
+      "  -j, --threads N       threads for the Delaunay triangulation, 0 = "
+      "one per core\n"
+      "                        (default %d)\n"
+      "      --report FILE     write the diagnostics as JSON to FILE\n"
+      "      --ascii           write ascii PLY or STL instead of binary\n"
+      "      --no-normals      do not write per-vertex normals\n"
+      "  -q, --quiet           no progress and no summary; errors only\n"
+      "  -h, --help            this text\n\n"
+      "Progress goes to stderr when it is a terminal; the summary goes to\n"
+      "stdout. Exit status: 0 done, 1 failed (the message says why), 2 bad\n"
+      "command line.\n",
+      sc_cli_mode_name(d.mode), d.r, d.cocone_theta * 180 / SC_PI,
+      d.max_hole_edges, d.threads);
+}
+
+enum { OPT_R = 256, OPT_THETA, OPT_MAX_HOLE, OPT_PAPER, OPT_REPORT, OPT_ASCII,
+       OPT_NO_NORMALS };
+
+static const struct option long_options[] = {
+    {"output", required_argument, NULL, 'o'},
+    {"mode", required_argument, NULL, 'm'},
+    {"r", required_argument, NULL, OPT_R},
+    {"theta", required_argument, NULL, OPT_THETA},
+    {"max-hole", required_argument, NULL, OPT_MAX_HOLE},
+    {"paper-pruning", no_argument, NULL, OPT_PAPER},
+    {"threads", required_argument, NULL, 'j'},
+    {"report", required_argument, NULL, OPT_REPORT},
+    {"ascii", no_argument, NULL, OPT_ASCII},
+    {"no-normals", no_argument, NULL, OPT_NO_NORMALS},
+    {"quiet", no_argument, NULL, 'q'},
+    {"help", no_argument, NULL, 'h'},
+    {NULL, 0, NULL, 0},
+};
+
+int sc_cmd_reconstruct(int argc, char **argv) {
+  sc_params_t params;
+  sc_params_init(&params);
+  const char *out_path = NULL, *report = NULL;
+  int quiet = 0, ascii = 0, normals = 1;
+  long l;
+  double v;
+
+  opterr = 0;
+  int c;
+  while ((c = getopt_long(argc, argv, ":o:m:j:qh", long_options, NULL)) != -1) {
+    switch (c) {
+    case 'o':
+      out_path = optarg;
+      break;
+    case 'm':
+      if (sc_cli_parse_mode("--mode", optarg, &params.mode) < 0)
+        return SC_EXIT_USAGE;
+      break;
+    case OPT_R:
+      if (sc_cli_parse_double("--r", optarg, &params.r) < 0)
+        return SC_EXIT_USAGE;
+      break;
+    case OPT_THETA:
+      if (sc_cli_parse_double("--theta", optarg, &v) < 0)
+        return SC_EXIT_USAGE;
+      params.cocone_theta = v * SC_PI / 180;
+      break;
+    case OPT_MAX_HOLE:
+      if (sc_cli_parse_int("--max-hole", optarg, 0, 100000, &l) < 0)
+        return SC_EXIT_USAGE;
+      params.max_hole_edges = (int)l;
+      break;
+    case OPT_PAPER:
+      params.paper_pruning = 1;
+      break;
+    case 'j':
+      if (sc_cli_parse_int("--threads", optarg, 0, 1024, &l) < 0)
+        return SC_EXIT_USAGE;
+      params.threads = (int)l;
+      break;
+    case OPT_REPORT:
+      report = optarg;
+      break;
+    case OPT_ASCII:
+      ascii = 1;
+      break;
+    case OPT_NO_NORMALS:
+      normals = 0;
+      break;
+    case 'q':
+      quiet = 1;
+      break;
+    case 'h':
+      usage(stdout);
+      return SC_EXIT_OK;
+    case ':':
+      sc_cli_error("reconstruct: %s needs a value", argv[optind - 1]);
+      return SC_EXIT_USAGE;
+    default:
+      sc_cli_error("reconstruct: unknown option '%s' (see shortcrust "
+                   "reconstruct --help)",
+                   argv[optind - 1]);
+      return SC_EXIT_USAGE;
+    }
+  }
+  if (optind >= argc) {
+    sc_cli_error("reconstruct: no input file (see shortcrust reconstruct "
+                 "--help)");
+    return SC_EXIT_USAGE;
+  }
+  if (optind + 1 < argc) {
+    sc_cli_error("reconstruct: one input file expected, got '%s' too",
+                 argv[optind + 1]);
+    return SC_EXIT_USAGE;
+  }
+  const char *in_path = argv[optind];
+  if (!out_path) {
+    sc_cli_error("reconstruct: no output file: give -o OUT");
+    return SC_EXIT_USAGE;
+  }
+
+  char msg[1024];
+  sc_mesh_format_t fmt;
+  if (sc_mesh_format_from_path(out_path, ascii, &fmt, msg, sizeof msg) < 0) {
+    sc_cli_error("%s", msg);
+    return SC_EXIT_USAGE;
+  }
+
+  sc_cli_progress_t progress;
+  sc_cli_progress_init(&progress, quiet);
+  params.progress = sc_cli_progress_fn;
+  params.progress_user = &progress;
+
+  double t0 = sc_cli_now();
+  sc_cli_progress_step(&progress, "reading", 0);
+  sc_points_t pts;
+  if (sc_points_read(in_path, &pts, msg, sizeof msg) < 0) {
+    sc_cli_progress_done(&progress);
+    sc_cli_error("%s", msg);
+    return SC_EXIT_FAILURE;
+  }
+  double t_read = sc_cli_now() - t0;
+
+  sc_mesh_t *mesh = NULL;
+  int rc = sc_reconstruct(pts.xyz, pts.count, &params, &mesh, msg, sizeof msg);
+  if (rc < 0) {
+    sc_cli_progress_done(&progress);
+    sc_points_free(&pts);
+    /* A parameter out of range is the command line's fault, not the file's. */
+    if (rc == SC_EINVALID_ARGUMENT) {
+      sc_cli_error("reconstruct: %s", msg);
+      return SC_EXIT_USAGE;
+    }
+    sc_cli_error("%s: %s", in_path, msg);
+    return SC_EXIT_FAILURE;
+  }
+
+  sc_cli_progress_step(&progress, "writing", 0);
+  t0 = sc_cli_now();
+  rc = sc_mesh_write(out_path, fmt, pts.xyz, pts.count, mesh->triangles,
+                     mesh->triangle_count, normals ? mesh->normals : NULL, msg,
+                     sizeof msg);
+  double t_write = sc_cli_now() - t0;
+  sc_cli_progress_done(&progress);
+  int status = SC_EXIT_OK;
+  if (rc < 0) {
+    sc_cli_error("%s", msg);
+    status = SC_EXIT_FAILURE;
+  } else {
+    sc_cli_result_t res = {
+        .command = "reconstruct",
+        .input = in_path,
+        .output = out_path,
+        .params = params,
+        .diag = &mesh->diag,
+        .component_genus = mesh->component_genus,
+        .component_count = mesh->component_count,
+        .seconds_read = t_read,
+        .seconds_write = t_write,
+    };
+    if (report && sc_cli_write_report(report, &res) < 0)
+      status = SC_EXIT_FAILURE;
+    if (!quiet)
+      sc_cli_summary(stdout, &res);
+  }
+  sc_mesh_free(mesh);
+  sc_points_free(&pts);
+  return status;
+}
