@@ -1,0 +1,85 @@
+#!/bin/sh
+# The local command end to end: formats, report, exit codes and messages.
+#   test_reconstruct.sh SHORTCRUST MESHINFO DATADIR
+# SPDX-License-Identifier: GPL-3.0-or-later
+set -u
+sc=$1 info=$2 data=$3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
+
+# expect STATUS PATTERN CMD...: exit status and a message matching PATTERN.
+expect() {
+  want=$1 pat=$2
+  shift 2
+  "$@" >"$tmp/out" 2>"$tmp/err"
+  got=$?
+  [ "$got" -eq "$want" ] || fail "$* exited $got, expected $want: $(cat "$tmp/err")"
+  [ -z "$pat" ] || grep -q -- "$pat" "$tmp/out" "$tmp/err" || fail "$*: no '$pat' in: $(cat "$tmp/out" "$tmp/err")"
+}
+
+knot=$data/knot1_points.ply
+expect 0 "usage: shortcrust reconstruct" "$sc" reconstruct --help
+for opt in --output --mode --r --theta --max-hole --paper-pruning --threads \
+           --report --ascii --no-normals --quiet; do
+  grep -q -- "$opt" "$tmp/out" || fail "--help does not mention $opt"
+done
+expect 0 "reconstruct" "$sc" --help
+expect 0 "shortcrust [0-9]" "$sc" --version
+
+# Every output format holds the same closed genus-1 surface.
+for ext in ply off obj; do
+  for ascii in "" --ascii; do
+    out=$tmp/knot.$ext
+    expect 0 "Closed 2-manifold, 1 component, genus 1" \
+      "$sc" reconstruct "$knot" -o "$out" $ascii
+    line=$("$info" "$out")
+    case $line in
+      *"manifold=1 closed=1 oriented=1 components=1 genus=1 unused=0 outward=1"*) ;;
+      *) fail "$out: $line" ;;
+    esac
+  done
+done
+expect 0 "genus 1" "$sc" reconstruct "$knot" -o "$tmp/knot.stl"
+tris=$("$info" "$tmp/knot.ply" | sed 's/.*triangles=\([0-9]*\).*/\1/')
+"$info" "$tmp/knot.stl" | grep -q "triangles=$tris " || fail "STL triangle count"
+
+# The report is JSON with the diagnostics; --quiet prints nothing.
+expect 0 "" "$sc" reconstruct "$knot" -o "$tmp/q.ply" --quiet --report "$tmp/r.json"
+[ -s "$tmp/out" ] && fail "--quiet printed: $(cat "$tmp/out")"
+for field in '"points_in": 3200,' '"closed": true' '"genus": 1' '"component_genus": \[1\]' \
+             '"triangles": '"$tris" '"mode": "cocone"' '"delaunay": '; do
+  grep -q "$field" "$tmp/r.json" || fail "report lacks $field"
+done
+expect 0 "mode shortcrust (r = 0.14)" "$sc" reconstruct "$knot" -o "$tmp/s.ply" --mode shortcrust --r 0.14
+expect 0 "" "$sc" reconstruct "$knot" -o "$tmp/t.ply" --threads 2 --quiet
+
+# Bad command lines: status 2, nothing written.
+expect 2 "no input file" "$sc" reconstruct -o "$tmp/x.ply"
+expect 2 "no output file" "$sc" reconstruct "$knot"
+expect 2 "unknown mode 'foo'" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --mode foo
+expect 2 "r must be in (0, 0.5)" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --r 0.7
+expect 2 "not a finite number" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --r abc
+expect 2 "out of range" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --threads -3
+expect 2 "unknown option '--bogus'" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --bogus
+expect 2 "unknown extension '.xyz'" "$sc" reconstruct "$knot" -o "$tmp/x.xyz"
+expect 2 "unknown command 'frobnicate'" "$sc" frobnicate
+[ -e "$tmp/x.ply" ] && fail "a failed command wrote its output"
+
+# Bad input: status 1, a message naming the file, an old output kept.
+echo "keep" > "$tmp/old.ply"
+expect 1 "missing.ply" "$sc" reconstruct "$tmp/missing.ply" -o "$tmp/old.ply"
+printf '0 0 0\n1 0 0\n0 nan 1\n0 0 1\n1 1 1\n' > "$tmp/nan.xyz"
+expect 1 "nan.xyz: point 2 has a non-finite y coordinate" \
+  "$sc" reconstruct "$tmp/nan.xyz" -o "$tmp/old.ply"
+printf '0 0 0\n1 0 0\n2 0 0\n3 0 0\n' > "$tmp/line.xyz"
+expect 1 "collinear" "$sc" reconstruct "$tmp/line.xyz" -o "$tmp/old.ply"
+printf 'ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0\n' > "$tmp/trunc.ply"
+expect 1 "trunc.ply" "$sc" reconstruct "$tmp/trunc.ply" -o "$tmp/old.ply"
+[ "$(cat "$tmp/old.ply")" = keep ] || fail "a failed run replaced the old output"
+ls "$tmp" | grep -q -v -E '^(old.ply|out|err|nan.xyz|line.xyz|trunc.ply|knot\..*|q.ply|r.json|s.ply|t.ply)$' &&
+  fail "temporary files left: $(ls "$tmp")"
+
+[ "$fails" -eq 0 ] && echo "all passed"
+exit $((fails != 0))

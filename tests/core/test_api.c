@@ -1,0 +1,170 @@
+/*
+ * The C boundary: error names, streaming against one call, threads,
+ * progress and cancellation at every stage, state errors.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "shortcrust.h"
+#include "testsupport.h"
+
+enum { N = 6000 };
+
+/* Each triangle rotated to start at its smallest index, then all sorted:
+ * the same surface with the same orientation gives the same array. */
+static int cmp_tri(const void *a, const void *b) {
+  return memcmp(a, b, 3 * sizeof(uint32_t)) < 0   ? -1
+         : memcmp(a, b, 3 * sizeof(uint32_t)) > 0 ? 1
+                                                  : 0;
+}
+static uint32_t *canonical(const sc_mesh_t *m) {
+  uint32_t *t = malloc(3 * m->triangle_count * sizeof *t + 1);
+  for (size_t i = 0; i < m->triangle_count; ++i) {
+    const uint32_t *s = m->triangles + 3 * i;
+    int k = s[0] < s[1] ? (s[0] < s[2] ? 0 : 2) : (s[1] < s[2] ? 1 : 2);
+    for (int j = 0; j < 3; ++j)
+      t[3 * i + j] = s[(k + j) % 3];
+  }
+  /* Sort big-endian-like: compare index by index. */
+  for (size_t i = 0; i < 3 * m->triangle_count; ++i) {
+    uint32_t v = t[i];
+    unsigned char *b = (unsigned char *)&t[i];
+    b[0] = (unsigned char)(v >> 24), b[1] = (unsigned char)(v >> 16);
+    b[2] = (unsigned char)(v >> 8), b[3] = (unsigned char)v;
+  }
+  qsort(t, m->triangle_count, 3 * sizeof *t, cmp_tri);
+  return t;
+}
+static int same_surface(const sc_mesh_t *a, const sc_mesh_t *b) {
+  if (a->triangle_count != b->triangle_count)
+    return 0;
+  uint32_t *x = canonical(a), *y = canonical(b);
+  int same = memcmp(x, y, 3 * a->triangle_count * sizeof *x) == 0;
+  free(x);
+  free(y);
+  return same;
+}
+
+typedef struct {
+  int cancel_stage; /* cancel at the first call in this stage; -1 never */
+  int calls;
+  int last_stage;
+  int regress; /* stage went backwards, or fraction out of [0, 1] */
+} progress_t;
+
+static int on_progress(void *user, sc_stage_t stage, double fraction) {
+  progress_t *p = user;
+  ++p->calls;
+  if ((int)stage < p->last_stage || !(fraction >= 0 && fraction <= 1))
+    p->regress = 1;
+  p->last_stage = (int)stage;
+  return (int)stage == p->cancel_stage;
+}
+
+int main(void) {
+  /* Every code has a distinct name and message; unknown codes say so. */
+  const int codes[] = {SC_EINVALID_ARGUMENT, SC_EDEGENERATE_INPUT,
+                       SC_ENONFINITE,        SC_ENO_MEMORY,
+                       SC_ECANCELLED,        SC_ETOO_MANY_POINTS,
+                       SC_EINTERNAL,         SC_EBAD_STATE};
+  for (size_t i = 0; i < sizeof codes / sizeof codes[0]; ++i) {
+    CHECK(codes[i] < 0);
+    CHECK(strcmp(sc_err_name(codes[i]), "UNKNOWN") != 0);
+    CHECK(strcmp(sc_strerror(codes[i]), "unknown error") != 0);
+    for (size_t j = 0; j < i; ++j)
+      CHECK(strcmp(sc_err_name(codes[i]), sc_err_name(codes[j])) != 0);
+  }
+  CHECK(strcmp(sc_err_name(-999), "UNKNOWN") == 0);
+  CHECK(strcmp(sc_strerror(-999), "unknown error") == 0);
+  CHECK(strcmp(sc_stage_name(SC_STAGE_DELAUNAY), "delaunay") == 0);
+  CHECK(strcmp(sc_stage_name(SC_STAGE_COUNT), "?") == 0);
+  CHECK(sc_estimate_bytes(2000000) > sc_estimate_bytes(1000000));
+
+  double *xyz = malloc(3 * N * sizeof *xyz);
+  sc_sample_surface(SC_SURF_TORUS, SC_DENSITY_UNIFORM, N, 11, xyz);
+  sc_params_t p;
+  sc_params_init(&p);
+  char msg[256];
+
+  sc_mesh_t *ref = NULL;
+  CHECK_EQ_INT(sc_reconstruct(xyz, N, &p, &ref, msg, sizeof msg), 0);
+  if (!ref)
+    return CHECK_DONE();
+  CHECK(ref->diag.closed && ref->diag.genus == 1);
+  CHECK_EQ_INT(ref->point_count, N);
+
+  /* Streaming in uneven chunks gives the same surface. */
+  sc_recon_t *r = NULL;
+  CHECK_EQ_INT(sc_recon_new(&p, &r), 0);
+  for (size_t at = 0; at < N;) {
+    size_t k = at == 0 ? 3 : 977; /* a first chunk too small to triangulate */
+    if (k > N - at)
+      k = N - at;
+    CHECK_EQ_INT(sc_recon_add(r, xyz + 3 * at, k, msg, sizeof msg), 0);
+    at += k;
+  }
+  sc_mesh_t *streamed = NULL;
+  CHECK_EQ_INT(sc_recon_finish(r, &streamed, msg, sizeof msg), 0);
+  CHECK(streamed && same_surface(ref, streamed));
+  /* A finished reconstruction takes nothing more. */
+  sc_mesh_t *again = NULL;
+  CHECK_EQ_INT(sc_recon_add(r, xyz, 1, msg, sizeof msg), SC_EBAD_STATE);
+  CHECK_EQ_INT(sc_recon_finish(r, &again, msg, sizeof msg), SC_EBAD_STATE);
+  CHECK(again == NULL);
+  sc_recon_free(r);
+  sc_mesh_free(streamed);
+  sc_recon_free(NULL);
+  sc_mesh_free(NULL);
+
+  /* A failed add leaves only free() allowed. */
+  CHECK_EQ_INT(sc_recon_new(&p, &r), 0);
+  double nan_pt[3] = {0, 0, 0};
+  nan_pt[1] = 0.0 / 0.0;
+  CHECK_EQ_INT(sc_recon_add(r, nan_pt, 1, msg, sizeof msg), SC_ENONFINITE);
+  CHECK_EQ_INT(sc_recon_add(r, xyz, N, msg, sizeof msg), SC_EBAD_STATE);
+  sc_recon_free(r);
+  sc_params_t bad = p;
+  bad.r = 2;
+  r = (sc_recon_t *)&r;
+  CHECK_EQ_INT(sc_recon_new(&bad, &r), SC_EINVALID_ARGUMENT);
+  CHECK(r == NULL);
+
+  /* The parallel triangulation gives the same surface. */
+  sc_params_t par = p;
+  par.threads = 2;
+  sc_mesh_t *pm = NULL;
+  CHECK_EQ_INT(sc_reconstruct(xyz, N, &par, &pm, msg, sizeof msg), 0);
+  CHECK(pm && same_surface(ref, pm));
+  sc_mesh_free(pm);
+
+  /* Progress visits the stages in order with fractions in [0, 1]. */
+  progress_t pr = {-1, 0, -1, 0};
+  p.progress = on_progress;
+  p.progress_user = &pr;
+  sc_mesh_t *m = NULL;
+  CHECK_EQ_INT(sc_reconstruct(xyz, N, &p, &m, msg, sizeof msg), 0);
+  CHECK(pr.calls > SC_STAGE_COUNT);
+  CHECK(!pr.regress);
+  CHECK_EQ_INT(pr.last_stage, SC_STAGE_EXTRACT);
+  sc_mesh_free(m);
+
+  /* Cancelling in any stage stops the run with CANCELLED and no mesh. */
+  for (int s = 0; s < SC_STAGE_COUNT; ++s) {
+    pr = (progress_t){s, 0, -1, 0};
+    m = (sc_mesh_t *)&m;
+    int rc = sc_reconstruct(xyz, N, &p, &m, msg, sizeof msg);
+    if (rc != SC_ECANCELLED)
+      fprintf(stderr, "cancel in stage %s: got %d\n", sc_stage_name(s), rc);
+    CHECK_EQ_INT(rc, SC_ECANCELLED);
+    CHECK(m == NULL);
+    CHECK_EQ_INT(pr.last_stage, s);
+  }
+
+  sc_mesh_free(ref);
+  free(xyz);
+  return CHECK_DONE();
+}
