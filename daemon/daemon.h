@@ -1,0 +1,186 @@
+/*
+ * Internals of shortcrustd shared by its files: the configuration, the
+ * server, connections and jobs. Everything here belongs to the loop thread;
+ * what workers see is in pool.h.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#ifndef SCD_DAEMON_H
+#define SCD_DAEMON_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include <uv.h>
+
+#include "pool.h"
+#include "scproto.h"
+#include "shortcrust.h"
+
+typedef struct scd_config {
+  /* Flags. */
+  const char *socket_path;  /* never NULL once main() is done with it */
+  unsigned socket_mode;     /* default 0660 */
+  unsigned workers;         /* default: available cores */
+  unsigned max_connections; /* default 64 */
+  unsigned max_jobs;        /* per connection; default 16 */
+  uint64_t max_points;      /* per job; default 10,000,000 */
+  uint64_t memory_budget;   /* bytes; default half of the memory */
+  double grace;             /* seconds; default 30 */
+  int log_level;            /* default info */
+
+  /* Fixed limits, not flags. */
+  uint32_t max_frame;          /* the largest frame we accept or send */
+  size_t out_soft;             /* output queued: stop reading above this */
+  size_t out_hard;             /* output queued: close above this */
+  uint64_t handshake_ms;       /* time allowed for HELLO */
+  uint64_t stall_ms;           /* output over out_soft and not moving */
+  uint64_t close_ms;           /* flushing the last frames before close */
+  uint64_t batch_points;       /* points a parked job gathers to run again */
+  unsigned max_invalid;        /* invalid requests in a row before close */
+} scd_config_t;
+
+/* Fills in every default. */
+void scd_config_init(scd_config_t *cfg);
+
+/* Counters for STATS; those ending in _total only grow. */
+typedef struct scd_counters {
+  uint64_t connections_total;
+  uint64_t connections_refused_total;
+  uint64_t jobs_accepted_total;
+  uint64_t jobs_refused_total;
+  uint64_t jobs_done_total;
+  uint64_t jobs_failed_total;
+  uint64_t jobs_cancelled_total;
+  uint64_t points_in_total;
+  uint64_t triangles_out_total;
+  uint64_t bytes_in_total;
+  uint64_t bytes_out_total;
+  uint64_t frames_in_total;
+  uint64_t frames_out_total;
+  uint64_t protocol_errors_total;
+  uint64_t slow_readers_closed_total;
+} scd_counters_t;
+
+typedef struct scd_conn scd_conn_t;
+typedef struct scd_job scd_job_t;
+
+typedef struct scd_server {
+  uv_loop_t *loop;
+  scd_config_t cfg;
+
+  uv_pipe_t listener;
+  int listener_open;
+  char socket_path[256];   /* as bound or as systemd gave it */
+  int unlink_at_exit;      /* we created the socket file */
+  int lock_fd;             /* held for the daemon's life; -1 when none */
+  char lock_path[272];
+
+  uv_signal_t sigterm, sigint;
+  uv_timer_t tick;         /* once a second: timeouts and the grace period */
+  scd_pool_t *pool;
+
+  scd_conn_t *conns;       /* every open connection */
+  unsigned conns_open;     /* counted against --max-connections */
+  uint64_t next_conn_id;
+
+  uint64_t tasks_in_pool;  /* submitted and not yet handed back */
+  uint64_t tasks_live;     /* created and not yet freed */
+  uint64_t budget_used;    /* bytes reserved by live tasks */
+  uint64_t max_points;     /* what WELCOME offers: flag and budget both */
+
+  int shutting_down;
+  int grace_over;
+  uint64_t grace_deadline_ns;
+  uint64_t final_deadline_ns;
+  int exit_code;
+
+  scd_counters_t n;
+  char readbuf[64 * 1024];
+  int reading;             /* readbuf is lent to libuv */
+} scd_server_t;
+
+/* Job phases, from the loop thread's view of the id (PROTOCOL.md 7.1). */
+enum {
+  SCD_JOB_UPLOADING = 1,
+  SCD_JOB_WORKING,   /* JOB_END came; the task is in the pool */
+  SCD_JOB_SENDING,   /* the mesh is going out */
+  SCD_JOB_DRAINING   /* JOB_ERROR sent before JOB_END or CANCEL */
+};
+
+struct scd_job {
+  scd_conn_t *conn;
+  scd_job_t *prev, *next;  /* the connection's jobs */
+  scd_job_t *snext;        /* the connection's sending queue */
+  uint32_t id;
+  int phase;
+  uint32_t flags;          /* JOB_BEGIN flags */
+  uint64_t declared;       /* JOB_BEGIN's point_count, 0 when unknown */
+  uint64_t received;       /* points taken so far */
+  scd_task_t *task;        /* NULL when rejected or draining */
+  scd_chunk_t *staging;    /* points gathered before going to the pool */
+  scp_mesh_cursor_t cursor;
+  uint64_t begin_ns, end_ns, done_ns; /* JOB_BEGIN, JOB_END, mesh back */
+};
+
+enum {
+  SCD_CONN_HANDSHAKE = 1,
+  SCD_CONN_READY,
+  SCD_CONN_CLOSING,   /* last frames going out, then close */
+  SCD_CONN_CLOSED     /* uv_close() called */
+};
+
+struct scd_conn {
+  uv_pipe_t pipe;
+  scd_server_t *srv;
+  scd_conn_t *prev, *next;
+  uint64_t id;
+  int state;
+  int counted;             /* counts against --max-connections */
+  int reading;             /* uv_read_start() in force */
+  scp_decoder_t *dec;
+
+  /* Output: frames are appended to out; wbuf is the one being written. */
+  scp_buf_t out, wbuf;
+  uv_write_t wreq;
+  int writing;
+  uv_shutdown_t sreq;
+  uint32_t max_frame;
+
+  scd_job_t *jobs;
+  unsigned njobs;
+  scd_job_t *shead, *stail; /* jobs whose mesh is going out, round-robin */
+
+  unsigned invalid_streak;
+  uint64_t open_ns, deadline_ns, stall_since_ns;
+  uint64_t bytes_in, bytes_out, jobs_total;
+  char close_reason[160];
+};
+
+/* server.c */
+int scd_server_run(const scd_config_t *cfg);
+void scd_server_maybe_finish(scd_server_t *srv);
+/* The budget: reserve returns 0 or -1 when the bytes do not fit. */
+int scd_budget_reserve(scd_server_t *srv, scd_task_t *t, uint64_t bytes);
+void scd_budget_set(scd_server_t *srv, scd_task_t *t, uint64_t bytes);
+/* Frees a task that is back from the pool (or never went) and its
+ * reservation. */
+void scd_server_free_task(scd_server_t *srv, scd_task_t *t);
+void scd_server_stats(scd_server_t *srv, scp_buf_t *b, uint32_t tag);
+
+/* conn.c */
+void scd_conn_accept(scd_server_t *srv);
+void scd_conn_task_event(scd_server_t *srv, scd_task_t *t, unsigned events,
+                         uint32_t stage, double fraction);
+/* Shutdown: stop queued jobs (grace_over 0) or every job (1), and close
+ * connections with nothing left to do. */
+void scd_conn_shutdown(scd_conn_t *c);
+void scd_conn_tick(scd_conn_t *c, uint64_t now);
+void scd_conn_close_now(scd_conn_t *c, const char *reason);
+
+/* listen.c */
+int scd_listen_open(scd_server_t *srv);
+void scd_listen_cleanup(scd_server_t *srv);
+
+#endif /* SCD_DAEMON_H */

@@ -1,0 +1,258 @@
+/*
+ * shortcrustd: command line and start-up.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "daemon.h"
+#include "log.h"
+
+#include <errno.h>
+#include <getopt.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef SC_VERSION
+#define SC_VERSION "unknown"
+#endif
+
+static char default_socket[4096];
+
+static const char *socket_default(void) {
+  const char *xdg = getenv("XDG_RUNTIME_DIR");
+  if (xdg && xdg[0] == '/')
+    snprintf(default_socket, sizeof default_socket, "%s/shortcrust.sock", xdg);
+  else
+    snprintf(default_socket, sizeof default_socket,
+             "/run/shortcrust/shortcrust.sock");
+  return default_socket;
+}
+
+static void usage(FILE *f, const scd_config_t *d) {
+  fprintf(f,
+          "Usage: shortcrustd [OPTION]...\n"
+          "Reconstruct triangle meshes from point clouds for clients on a "
+          "Unix socket.\n"
+          "\n"
+          "  --socket PATH          listen on PATH (default: "
+          "$XDG_RUNTIME_DIR/shortcrust.sock,\n"
+          "                         else /run/shortcrust/shortcrust.sock; "
+          "here %s);\n"
+          "                         ignored under systemd socket activation\n"
+          "  --socket-mode MODE     permissions of the socket file, octal "
+          "(default 0660)\n"
+          "  --workers N            reconstruction threads (default: the "
+          "number of cores, here %u)\n"
+          "  --max-connections N    clients connected at once (default %u)\n"
+          "  --max-jobs N           jobs in use at once on one connection "
+          "(default %u)\n"
+          "  --max-points N         points in one job (default %llu)\n"
+          "  --memory-budget BYTES  memory for the points and meshes of all "
+          "jobs, estimated\n"
+          "                         per point; suffixes K, M, G, T (powers "
+          "of 1024) (default:\n"
+          "                         half of the memory, here %llu)\n"
+          "  --grace SECONDS        on SIGTERM or SIGINT, time running jobs "
+          "get to finish\n"
+          "                         (default %g)\n"
+          "  --log-level LEVEL      error, warn, info or debug (default "
+          "info)\n"
+          "  --help                 show this help and exit\n"
+          "  --version              show the version and exit\n"
+          "\n"
+          "Logs go to stderr. SIGTERM and SIGINT stop accepting clients, "
+          "let running jobs\n"
+          "finish within the grace period, end queued jobs with SHUTDOWN, "
+          "remove the socket\n"
+          "file and exit 0; a second signal ends the grace period at once.\n",
+          socket_default(), d->workers, d->max_connections, d->max_jobs,
+          (unsigned long long)d->max_points,
+          (unsigned long long)d->memory_budget, d->grace);
+}
+
+static int bad_value(const char *opt, const char *value, const char *want) {
+  fprintf(stderr, "shortcrustd: invalid %s '%s': %s\n", opt, value, want);
+  return -1;
+}
+
+static int parse_u64(const char *s, uint64_t min, uint64_t max,
+                     uint64_t *out) {
+  if (!*s || *s == '-' || *s == '+')
+    return -1;
+  char *end;
+  errno = 0;
+  unsigned long long v = strtoull(s, &end, 10);
+  if (errno || *end || v < min || v > max)
+    return -1;
+  *out = v;
+  return 0;
+}
+
+static int parse_bytes(const char *s, uint64_t *out) {
+  if (!*s || *s == '-' || *s == '+')
+    return -1;
+  char *end;
+  errno = 0;
+  unsigned long long v = strtoull(s, &end, 10);
+  if (errno || end == s)
+    return -1;
+  unsigned shift = 0;
+  switch (*end) {
+  case '\0':
+    break;
+  case 'k':
+  case 'K':
+    shift = 10;
+    break;
+  case 'M':
+    shift = 20;
+    break;
+  case 'G':
+    shift = 30;
+    break;
+  case 'T':
+    shift = 40;
+    break;
+  default:
+    return -1;
+  }
+  if (*end && end[1] != '\0' && strcmp(end + 1, "iB") != 0 &&
+      strcmp(end + 1, "B") != 0)
+    return -1;
+  if (shift && v > (UINT64_MAX >> shift))
+    return -1;
+  *out = (uint64_t)v << shift;
+  return *out ? 0 : -1;
+}
+
+enum {
+  OPT_SOCKET = 256,
+  OPT_SOCKET_MODE,
+  OPT_WORKERS,
+  OPT_MAX_CONNECTIONS,
+  OPT_MAX_JOBS,
+  OPT_MAX_POINTS,
+  OPT_MEMORY_BUDGET,
+  OPT_GRACE,
+  OPT_LOG_LEVEL,
+  OPT_HELP,
+  OPT_VERSION
+};
+
+/* 0: run; 1: exit 0 (help, version); -1: exit 2. */
+static int parse_args(int argc, char **argv, scd_config_t *cfg) {
+  static const struct option opts[] = {
+      {"socket", required_argument, NULL, OPT_SOCKET},
+      {"socket-mode", required_argument, NULL, OPT_SOCKET_MODE},
+      {"workers", required_argument, NULL, OPT_WORKERS},
+      {"max-connections", required_argument, NULL, OPT_MAX_CONNECTIONS},
+      {"max-jobs", required_argument, NULL, OPT_MAX_JOBS},
+      {"max-points", required_argument, NULL, OPT_MAX_POINTS},
+      {"memory-budget", required_argument, NULL, OPT_MEMORY_BUDGET},
+      {"grace", required_argument, NULL, OPT_GRACE},
+      {"log-level", required_argument, NULL, OPT_LOG_LEVEL},
+      {"help", no_argument, NULL, OPT_HELP},
+      {"version", no_argument, NULL, OPT_VERSION},
+      {NULL, 0, NULL, 0}};
+  scd_config_t defaults = *cfg;
+  int opt;
+  uint64_t v;
+  opterr = 0;
+  while ((opt = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+    const char *name = optind > 0 && optind <= argc ? argv[optind - 1] : "?";
+    switch (opt) {
+    case OPT_SOCKET:
+      if (!*optarg)
+        return bad_value("--socket", optarg, "an empty path");
+      cfg->socket_path = optarg;
+      break;
+    case OPT_SOCKET_MODE: {
+      char *end;
+      errno = 0;
+      unsigned long m = strtoul(optarg, &end, 8);
+      if (errno || *end || !*optarg || m > 0777)
+        return bad_value("--socket-mode", optarg,
+                         "want an octal mode such as 0660");
+      cfg->socket_mode = (unsigned)m;
+      break;
+    }
+    case OPT_WORKERS:
+      if (parse_u64(optarg, 1, 1024, &v))
+        return bad_value("--workers", optarg, "want 1 to 1024");
+      cfg->workers = (unsigned)v;
+      break;
+    case OPT_MAX_CONNECTIONS:
+      if (parse_u64(optarg, 1, 100000, &v))
+        return bad_value("--max-connections", optarg, "want 1 to 100000");
+      cfg->max_connections = (unsigned)v;
+      break;
+    case OPT_MAX_JOBS:
+      if (parse_u64(optarg, 1, 100000, &v))
+        return bad_value("--max-jobs", optarg, "want 1 to 100000");
+      cfg->max_jobs = (unsigned)v;
+      break;
+    case OPT_MAX_POINTS:
+      if (parse_u64(optarg, 4, 0xFFFFFFFEu, &v))
+        return bad_value("--max-points", optarg, "want 4 to 4294967294");
+      cfg->max_points = v;
+      break;
+    case OPT_MEMORY_BUDGET:
+      if (parse_bytes(optarg, &cfg->memory_budget))
+        return bad_value("--memory-budget", optarg,
+                         "want bytes, optionally with K, M, G or T");
+      break;
+    case OPT_GRACE: {
+      char *end;
+      errno = 0;
+      double g = strtod(optarg, &end);
+      if (errno || *end || !*optarg || !isfinite(g) || g < 0 || g > 86400)
+        return bad_value("--grace", optarg, "want 0 to 86400 seconds");
+      cfg->grace = g;
+      break;
+    }
+    case OPT_LOG_LEVEL: {
+      int l = scd_log_level_from_name(optarg);
+      if (l < 0)
+        return bad_value("--log-level", optarg,
+                         "want error, warn, info or debug");
+      cfg->log_level = l;
+      break;
+    }
+    case OPT_HELP:
+      usage(stdout, &defaults);
+      return 1;
+    case OPT_VERSION:
+      printf("shortcrustd %s (protocol version %d)\n", SC_VERSION,
+             SCP_VERSION);
+      return 1;
+    default:
+      if (optopt)
+        fprintf(stderr, "shortcrustd: option %s needs a value\n", name);
+      else
+        fprintf(stderr, "shortcrustd: unknown option %s\n", name);
+      fprintf(stderr, "Try 'shortcrustd --help'.\n");
+      return -1;
+    }
+  }
+  if (optind < argc) {
+    fprintf(stderr, "shortcrustd: unexpected argument '%s'\n", argv[optind]);
+    fprintf(stderr, "Try 'shortcrustd --help'.\n");
+    return -1;
+  }
+  if (!cfg->socket_path)
+    cfg->socket_path = socket_default();
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  scd_config_t cfg;
+  scd_config_init(&cfg);
+  int rc = parse_args(argc, argv, &cfg);
+  if (rc != 0)
+    return rc > 0 ? 0 : 2;
+  scd_log_init(cfg.log_level);
+  return scd_server_run(&cfg);
+}
