@@ -1,0 +1,293 @@
+/*
+ * The daemon harness; see harness.h.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "harness.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "testsupport.h"
+
+atomic_int scdt_failures;
+
+static const char *daemon_path;
+#define SCDT_MAX_DAEMONS 16
+static scdt_daemon_t *daemons[SCDT_MAX_DAEMONS];
+static int ndaemons;
+
+void scdt_init(int argc, char **argv) {
+  signal(SIGPIPE, SIG_IGN);
+  if (argc < 2) {
+    fprintf(stderr, "usage: %s PATH-TO-SHORTCRUSTD\n", argv[0]);
+    exit(2);
+  }
+  daemon_path = argv[1];
+  /* Each test's output in order, even when it goes to a pipe. */
+  setvbuf(stdout, NULL, _IOLBF, 0);
+}
+
+const char *scdt_daemon_binary(void) { return daemon_path; }
+
+void scdt_sleep_ms(unsigned ms) {
+  struct timespec ts = {.tv_sec = ms / 1000, .tv_nsec = (ms % 1000) * 1000000L};
+  while (nanosleep(&ts, &ts) != 0 && errno == EINTR)
+    ;
+}
+
+static void print_log(const scdt_daemon_t *d) {
+  FILE *f = fopen(d->log, "r");
+  if (!f)
+    return;
+  fprintf(stderr, "---- %s\n", d->log);
+  char line[4096];
+  while (fgets(line, sizeof line, f))
+    fputs(line, stderr);
+  fprintf(stderr, "----\n");
+  fclose(f);
+}
+
+static void remove_dir(const char *dir) {
+  DIR *dh = opendir(dir);
+  if (!dh)
+    return;
+  struct dirent *e;
+  char path[512];
+  while ((e = readdir(dh)) != NULL) {
+    if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+      continue;
+    snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+    unlink(path);
+  }
+  closedir(dh);
+  rmdir(dir);
+}
+
+int scdt_finish(void) {
+  int failed = atomic_load(&scdt_failures);
+  for (int i = 0; i < ndaemons; i++) {
+    scdt_daemon_t *d = daemons[i];
+    if (d->pid > 0) {
+      kill(d->pid, SIGKILL);
+      waitpid(d->pid, NULL, 0);
+      d->pid = 0;
+    }
+    if (failed || getenv("SCDT_SHOW_LOGS"))
+      print_log(d);
+    remove_dir(d->dir);
+  }
+  ndaemons = 0;
+  if (failed)
+    fprintf(stderr, "%d check(s) failed\n", failed);
+  return failed ? 1 : 0;
+}
+
+void scdt_abort(void) { exit(scdt_finish() ? 1 : 1); }
+
+int scdt_daemon_prepare(scdt_daemon_t *d) {
+  memset(d, 0, sizeof *d);
+  d->status = -1;
+  const char *tmp = getenv("TMPDIR");
+  /* A socket path must fit in 108 bytes. */
+  if (!tmp || !*tmp || strlen(tmp) > 60)
+    tmp = "/tmp";
+  snprintf(d->dir, sizeof d->dir, "%s/scd-test.XXXXXX", tmp);
+  if (!mkdtemp(d->dir)) {
+    fprintf(stderr, "mkdtemp %s: %s\n", d->dir, strerror(errno));
+    return -1;
+  }
+  snprintf(d->sock, sizeof d->sock, "%s/d.sock", d->dir);
+  snprintf(d->log, sizeof d->log, "%s/daemon.log", d->dir);
+  if (ndaemons < SCDT_MAX_DAEMONS)
+    daemons[ndaemons++] = d;
+  return 0;
+}
+
+int scdt_daemon_spawn(scdt_daemon_t *d, const char *const *args,
+                      int wait_ready) {
+  const char *argv[64];
+  int n = 0;
+  argv[n++] = daemon_path;
+  argv[n++] = "--socket";
+  argv[n++] = d->sock;
+  argv[n++] = "--log-level";
+  argv[n++] = "debug";
+  for (int i = 0; args && args[i] && n < 63; i++)
+    argv[n++] = args[i];
+  argv[n] = NULL;
+  int logfd = open(d->log, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (logfd < 0)
+    return -1;
+  pid_t pid = fork();
+  if (pid < 0) {
+    close(logfd);
+    return -1;
+  }
+  if (pid == 0) {
+    dup2(logfd, STDERR_FILENO);
+    int null = open("/dev/null", O_RDWR);
+    if (null >= 0) {
+      dup2(null, STDIN_FILENO);
+      dup2(null, STDOUT_FILENO);
+    }
+    execv(daemon_path, (char *const *)argv);
+    _exit(127);
+  }
+  close(logfd);
+  d->pid = pid;
+  d->status = -1;
+  if (!wait_ready)
+    return 0;
+  /* Sanitizer builds start slowly. */
+  uint64_t deadline = scdt_now_ms() + 30000;
+  while (scdt_now_ms() < deadline) {
+    scdt_conn_t *c;
+    if (scdt_connect(d->sock, &c) == 0) {
+      /* A connection that goes away at once costs the daemon nothing. */
+      scdt_close(c);
+      return 0;
+    }
+    if (scdt_daemon_wait(d, 0) >= 0) {
+      fprintf(stderr, "daemon exited with status %d before it was ready\n",
+              d->status);
+      return -1;
+    }
+    scdt_sleep_ms(10);
+  }
+  fprintf(stderr, "daemon not ready after 30 s\n");
+  return -1;
+}
+
+int scdt_daemon_start(scdt_daemon_t *d, const char *const *args) {
+  if (scdt_daemon_prepare(d) != 0)
+    return -1;
+  return scdt_daemon_spawn(d, args, 1);
+}
+
+int scdt_daemon_wait(scdt_daemon_t *d, int timeout_ms) {
+  if (d->pid <= 0)
+    return d->status;
+  uint64_t deadline = scdt_now_ms() + (uint64_t)timeout_ms;
+  for (;;) {
+    int st;
+    pid_t r = waitpid(d->pid, &st, WNOHANG);
+    if (r == d->pid) {
+      d->pid = 0;
+      d->status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+      return d->status;
+    }
+    if (scdt_now_ms() >= deadline)
+      return -1;
+    scdt_sleep_ms(5);
+  }
+}
+
+int scdt_daemon_stop(scdt_daemon_t *d) {
+  if (d->pid > 0)
+    kill(d->pid, SIGTERM);
+  return scdt_daemon_wait(d, 60000);
+}
+
+static int log_scan(const scdt_daemon_t *d, const char *text, int count_all) {
+  FILE *f = fopen(d->log, "r");
+  if (!f)
+    return 0;
+  char line[8192];
+  int n = 0;
+  while (fgets(line, sizeof line, f)) {
+    if (strstr(line, text)) {
+      n++;
+      if (!count_all)
+        break;
+    }
+  }
+  fclose(f);
+  return n;
+}
+
+int scdt_log_contains(const scdt_daemon_t *d, const char *text) {
+  return log_scan(d, text, 0) > 0;
+}
+
+int scdt_log_count(const scdt_daemon_t *d, const char *text) {
+  return log_scan(d, text, 1);
+}
+
+double *scdt_sample(int surface, size_t n, uint64_t seed) {
+  double *xyz = malloc(n * 3 * sizeof(double));
+  if (!xyz)
+    return NULL;
+  if (sc_sample_surface((sc_surface_t)surface, SC_DENSITY_UNIFORM, n, seed,
+                        xyz) != SC_TS_OK) {
+    free(xyz);
+    return NULL;
+  }
+  return xyz;
+}
+
+int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {
+  if (!j->done) {
+    snprintf(why, len, "job %u did not finish: error %s: %s", j->id,
+             scp_wire_name(j->error_code), j->error_msg);
+    return 0;
+  }
+  sc_meshcheck_t mc;
+  if (sc_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SC_TS_OK) {
+    snprintf(why, len, "job %u: mesh check failed to run", j->id);
+    return 0;
+  }
+  char reason[512];
+  int ok = sc_meshcheck_expect(&mc, (sc_surface_t)surface, SC_EXPECT_OUTWARD,
+                               reason, sizeof reason);
+  if (!ok) {
+    char sum[512];
+    snprintf(why, len, "job %u (%s, %llu points): %s; %s", j->id,
+             sc_surface_name((sc_surface_t)surface),
+             (unsigned long long)j->n, reason,
+             sc_meshcheck_summary(&mc, sum, sizeof sum));
+  } else if (j->diag_triangles != j->ntri) {
+    snprintf(why, len, "job %u: JOB_DONE diagnostics say %llu triangles, "
+             "%llu came",
+             j->id, (unsigned long long)j->diag_triangles,
+             (unsigned long long)j->ntri);
+    ok = 0;
+  } else if ((int64_t)mc.genus_total != j->diag_genus) {
+    snprintf(why, len, "job %u: diagnostics genus %lld, mesh genus %lld",
+             j->id, (long long)j->diag_genus, (long long)mc.genus_total);
+    ok = 0;
+  }
+  sc_meshcheck_free(&mc);
+  return ok;
+}
+
+uint64_t scdt_stat_fresh(const char *sock, const char *name) {
+  scdt_conn_t *c;
+  if (scdt_open(sock, SCP_FRAME_MIN, &c) != 0)
+    return UINT64_MAX;
+  uint64_t v;
+  int rc = scdt_stat(c, name, &v);
+  scdt_close(c);
+  return rc == 0 ? v : UINT64_MAX;
+}
+
+uint64_t scdt_stat_wait(const char *sock, const char *name, uint64_t want,
+                        int timeout_ms) {
+  uint64_t deadline = scdt_now_ms() + (uint64_t)timeout_ms;
+  uint64_t v;
+  for (;;) {
+    v = scdt_stat_fresh(sock, name);
+    if (v == want || scdt_now_ms() >= deadline)
+      return v;
+    scdt_sleep_ms(20);
+  }
+}

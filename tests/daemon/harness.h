@@ -1,0 +1,111 @@
+/*
+ * Running the real daemon for a test: each test starts shortcrustd on a
+ * private socket in a fresh temporary directory, with its stderr in a log
+ * file there, and stops it with SIGTERM (checking the exit status) at the
+ * end. Plus thread-safe checks that print both sides, point samples, and
+ * the mesh check every result goes through.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#ifndef SCDT_HARNESS_H
+#define SCDT_HARNESS_H
+
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <sys/types.h>
+
+#include "client.h"
+
+extern atomic_int scdt_failures;
+
+#define CHECK(cond, ...)                                                       \
+  do {                                                                         \
+    if (!(cond)) {                                                             \
+      fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__,        \
+              #cond);                                                          \
+      fprintf(stderr, __VA_ARGS__);                                            \
+      fputc('\n', stderr);                                                     \
+      atomic_fetch_add(&scdt_failures, 1);                                     \
+    }                                                                          \
+  } while (0)
+
+#define CHECK_EQ(a, b)                                                         \
+  do {                                                                         \
+    long long a_ = (long long)(a), b_ = (long long)(b);                        \
+    if (a_ != b_) {                                                            \
+      fprintf(stderr, "%s:%d: check failed: %s == %s: %lld vs %lld\n",         \
+              __FILE__, __LINE__, #a, #b, a_, b_);                             \
+      atomic_fetch_add(&scdt_failures, 1);                                     \
+    }                                                                          \
+  } while (0)
+
+/* Stops the test at once (after printing) when a precondition fails. */
+#define REQUIRE(cond, ...)                                                     \
+  do {                                                                         \
+    if (!(cond)) {                                                             \
+      fprintf(stderr, "%s:%d: required: %s: ", __FILE__, __LINE__, #cond);     \
+      fprintf(stderr, __VA_ARGS__);                                            \
+      fputc('\n', stderr);                                                     \
+      atomic_fetch_add(&scdt_failures, 1);                                     \
+      scdt_abort();                                                            \
+    }                                                                          \
+  } while (0)
+
+typedef struct scdt_daemon {
+  pid_t pid;
+  char dir[128];
+  char sock[160];
+  char log[160];
+  int status; /* exit code once it has exited, or 128 + signal */
+} scdt_daemon_t;
+
+/* argv[1] is the daemon binary. Also ignores SIGPIPE. */
+void scdt_init(int argc, char **argv);
+const char *scdt_daemon_binary(void);
+/* Removes every daemon's directory (and kills those still running), prints
+ * their logs when a check failed, and returns the exit code. */
+int scdt_finish(void);
+/* Like scdt_finish(), for REQUIRE. */
+void scdt_abort(void) __attribute__((noreturn));
+
+/* A new private directory; fills d->dir, d->sock ("DIR/d.sock") and d->log
+ * without starting anything. */
+int scdt_daemon_prepare(scdt_daemon_t *d);
+/* Starts the daemon with --socket d->sock --log-level debug and the extra
+ * arguments (NULL-terminated, may be NULL); stderr goes to d->log. With
+ * wait_ready, returns once the socket accepts connections (-1 if the
+ * daemon exited first or took too long). */
+int scdt_daemon_spawn(scdt_daemon_t *d, const char *const *args,
+                      int wait_ready);
+/* prepare + spawn(wait_ready). */
+int scdt_daemon_start(scdt_daemon_t *d, const char *const *args);
+/* Waits for the process: its exit status as in d->status, or -1 after
+ * timeout_ms (the process then still runs). */
+int scdt_daemon_wait(scdt_daemon_t *d, int timeout_ms);
+/* SIGTERM and wait up to a minute; the exit status, or -1. */
+int scdt_daemon_stop(scdt_daemon_t *d);
+/* 1 when the log contains the text. */
+int scdt_log_contains(const scdt_daemon_t *d, const char *text);
+/* Counts lines of the log containing the text. */
+int scdt_log_count(const scdt_daemon_t *d, const char *text);
+
+/* Well-spaced samples of a test surface (sc_surface_t), malloc'd. */
+double *scdt_sample(int surface, size_t n, uint64_t seed);
+/* 1 when job j came back as a correct mesh of `surface` over its own points
+ * (closed manifold, oriented, right components and genus); otherwise 0
+ * with the reason in why. */
+int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len);
+
+/* A STATS value read on a fresh connection; UINT64_MAX when that fails. */
+uint64_t scdt_stat_fresh(const char *sock, const char *name);
+/* Polls scdt_stat_fresh() until the value equals want or timeout_ms pass;
+ * returns the last value read. */
+uint64_t scdt_stat_wait(const char *sock, const char *name, uint64_t want,
+                        int timeout_ms);
+
+/* A one-shot sleep. */
+void scdt_sleep_ms(unsigned ms);
+
+#endif /* SCDT_HARNESS_H */
