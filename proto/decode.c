@@ -23,6 +23,11 @@
 #include "scproto.h"
 #include "wire.h"
 
+/* An idle decoder whose buffer grew beyond this gives the memory back, so
+ * that a connection that once received a large frame does not keep its
+ * peak forever. */
+#define DECODER_KEEP (64 * 1024)
+
 struct scp_decoder {
   uint8_t *buf;
   size_t cap;
@@ -114,6 +119,11 @@ int scp_decoder_feed(scp_decoder_t *d, const void *bytes, size_t len) {
     len -= n;
     if (len == 0)
       return 0;
+  }
+  if (d->start == d->end && d->cap > DECODER_KEEP && len < d->cap / 4) {
+    free(d->buf);
+    d->buf = NULL;
+    d->cap = 0;
   }
   size_t unread = d->end - d->start;
   if (d->cap - d->end < len) {
@@ -231,4 +241,5 @@ uint32_t scp_decoder_max_frame(const scp_decoder_t *d) { return d->max_frame; }
 void scp_decoder_get_counters(const scp_decoder_t *d,
                               scp_decoder_counters_t *out) {
   *out = d->counters;
+  out->buffer = d->cap;
 }

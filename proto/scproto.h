@@ -523,7 +523,8 @@ void scp_limits_init(scp_limits_t *l);
  * Nothing is allocated on the word of a length field. The decoder copies
  * what it is fed; if the caller drains it with scp_decoder_next() until that
  * returns 0 after every feed, it holds at most one partial frame (below the
- * frame size limit) plus the bytes of one feed.
+ * frame size limit) plus the bytes of one feed, and it frees a large buffer
+ * once it is empty again.
  *
  * Errors in the stream are sticky: once next(), feed() or eof() has
  * returned one, every later call returns the same code, because nothing
@@ -563,6 +564,7 @@ typedef struct scp_decoder_counters {
   uint64_t bytes;   /* bytes fed */
   uint64_t frames;  /* frames returned by scp_decoder_next() */
   uint64_t skipped; /* ignorable frames of unknown types, dropped */
+  uint64_t buffer;  /* bytes allocated for the buffer now */
 } scp_decoder_counters_t;
 void scp_decoder_get_counters(const scp_decoder_t *d,
                               scp_decoder_counters_t *out);
