@@ -9,7 +9,10 @@
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <CGAL/spatial_sort.h>
+#include <CGAL/Spatial_sort_traits_adapter_3.h>
 #ifdef CGAL_LINKED_WITH_TBB
 #include <tbb/task_arena.h>
 #endif
@@ -18,14 +21,33 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 
 namespace sc {
 namespace {
 
 typedef CGAL::Exact_predicates_inexact_constructions_kernel K;
 typedef K::Point_3 Point;
-typedef CGAL::Triangulation_vertex_base_with_info_3<uint32_t, K> Vb;
-typedef CGAL::Delaunay_triangulation_cell_base_3<K> Cb;
+// What the filtering keeps on each vertex and cell, so that the pass over
+// the facets reads only the two cells of a facet and their vertices, never
+// arrays indexed by input order (which is random and would miss the cache at
+// every access on large inputs).
+struct VertexData {
+  uint32_t idx = 0; // index of the point in the input
+  float best = -1;  // squared distance to the pole so far; inf on the hull
+  double pole[3] = {0, 0, 0}; // pole direction, unit once computed
+  VertexData() = default;
+  VertexData(uint32_t i) : idx(i) {}
+};
+// Single precision is ample for where a Voronoi vertex lies relative to the
+// cocones and balls it is tested against, and keeps cells at 80 bytes.
+struct CellData {
+  float cc[3]; // circumcentre (guarded), set by the poles stage
+};
+typedef CGAL::Triangulation_vertex_base_with_info_3<VertexData, K> Vb;
+typedef CGAL::Triangulation_cell_base_with_info_3<
+    CellData, K, CGAL::Delaunay_triangulation_cell_base_3<K>>
+    Cb;
 typedef CGAL::Triangulation_data_structure_3<Vb, Cb, CGAL::Sequential_tag>
     TdsSeq;
 typedef CGAL::Delaunay_triangulation_3<K, TdsSeq> DtSeq;
@@ -132,8 +154,8 @@ inline int cone_side(V3 dir, V3 pole_unit, double sin_cocone) {
 
 // The candidate test for triangle abc with indices idx. The dual Voronoi
 // edge runs from v1 to v2, or from v1 along direction v2 when `ray`.
-bool is_candidate(const Criteria &cr, const V3 *P, const uint32_t *idx,
-                  const double *poles, V3 v1, V3 v2, bool ray) {
+bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles, V3 v1,
+                  V3 v2, bool ray) {
   V3 n = cross(P[1] - P[0], P[2] - P[0]);
   double n2 = norm2(n);
   if (!(n2 > 0))
@@ -142,8 +164,7 @@ bool is_candidate(const Criteria &cr, const V3 *P, const uint32_t *idx,
 
   if (cr.mode == SC_MODE_COCONE) {
     for (int k = 0; k < 3; ++k) {
-      const double *pp = poles + 3 * size_t(idx[k]);
-      V3 pole = {pp[0], pp[1], pp[2]};
+      const V3 &pole = poles[k];
       int s1 = cone_side(v1 - P[k], pole, cr.sin_cocone);
       if (s1 == 0)
         continue;
@@ -160,9 +181,7 @@ bool is_candidate(const Criteria &cr, const V3 *P, const uint32_t *idx,
   double l0 = norm2(P[1] - P[2]), l1 = norm2(P[0] - P[2]),
          l2 = norm2(P[0] - P[1]);
   int s = l0 >= l1 ? (l0 >= l2 ? 0 : 2) : (l1 >= l2 ? 1 : 2);
-  const double *pp = poles + 3 * size_t(idx[s]);
-  V3 pole = {pp[0], pp[1], pp[2]};
-  if (std::fabs(dot(n, pole)) < cr.cos_theta1)
+  if (std::fabs(dot(n, poles[s])) < cr.cos_theta1)
     return false;
 
   // Criterion 2: the dual edge's height interval above the triangle's
@@ -192,19 +211,32 @@ public:
 
   void insert(const double *xyz, size_t first, size_t n,
               Progress &progress) override {
-    // Batches give progress and cancellation points; each batch is
-    // spatially sorted by CGAL, so locality is kept within it.
-    const size_t batch = std::max<size_t>(1u << 16, n / 16);
-    std::vector<std::pair<Point, uint32_t>> buf;
-    buf.reserve(std::min(batch, n));
+    // One spatial sort of the whole range, then batches along it: the
+    // batches give progress and cancellation points, and each continues
+    // where the last one ended, so insertion keeps the locality of a single
+    // sorted insert.
+    std::vector<Point> pts;
+    pts.reserve(n);
+    for (size_t i = first; i < first + n; ++i)
+      pts.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    typedef CGAL::Spatial_sort_traits_adapter_3<
+        K, CGAL::Pointer_property_map<Point>::const_type>
+        SortTraits;
+    CGAL::spatial_sort(order.begin(), order.end(),
+                       SortTraits(CGAL::make_property_map(
+                           static_cast<const std::vector<Point> &>(pts))));
+    const size_t batch = std::max<size_t>(1u << 14, n / 64);
+    Ch hint;
     for (size_t done = 0; done < n; done += batch) {
       progress.report(double(done) / double(n));
       size_t m = std::min(batch, n - done);
-      buf.clear();
-      for (size_t i = first + done; i < first + done + m; ++i)
-        buf.emplace_back(Point(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]),
-                         uint32_t(i));
-      dt_.insert(buf.begin(), buf.end());
+      for (size_t k = done; k < done + m; ++k) {
+        Vh v = dt_.insert(pts[order[k]], hint);
+        v->info().idx = uint32_t(first + order[k]);
+        hint = v->cell();
+      }
     }
     progress.report(1.0);
   }
@@ -219,14 +251,24 @@ public:
     resolve_duplicates(xyz, n, out.dups);
     diag.duplicates_merged = out.dups.size();
     diag.delaunay_vertices = dt_.number_of_vertices();
+    // From here on vertices go by their rank in the triangulation's own
+    // order, which follows the spatial sort: every later array indexed by
+    // vertex is then read with locality, whatever the input order.
+    out.to_input.clear();
+    out.to_input.reserve(dt_.number_of_vertices());
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v) {
+      out.to_input.push_back(v->info().idx);
+      v->info().idx = uint32_t(out.to_input.size() - 1);
+    }
     seconds[SC_STAGE_DELAUNAY] += sw.lap();
 
     progress.stage(SC_STAGE_POLES);
-    compute_poles(n, progress, out.poles, diag);
+    compute_poles(out.to_input.size(), progress, out.poles, diag);
     seconds[SC_STAGE_POLES] += sw.lap();
 
     progress.stage(SC_STAGE_CANDIDATES);
-    select_candidates(params, progress, out.poles, out.tris, diag);
+    select_candidates(params, progress, out.tris, diag);
     diag.candidates = out.tris.size() / 3;
     // The triangulation is not needed any more: free it before pruning so
     // that the peak memory is the triangulation's alone.
@@ -249,7 +291,7 @@ private:
     std::vector<bool> seen(n, false);
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v)
-      seen[v->info()] = true;
+      seen[v->info().idx] = true;
     Ch hint;
     for (size_t i = 0; i < n; ++i) {
       if (seen[i])
@@ -262,10 +304,10 @@ private:
         throw Error(SC_EINTERNAL, "a point missing from the triangulation");
       hint = c;
       Vh v = c->vertex(li);
-      uint32_t j = v->info();
+      uint32_t j = v->info().idx;
       if (j > i) {
         dups.emplace_back(j, uint32_t(i));
-        v->info() = uint32_t(i);
+        v->info().idx = uint32_t(i);
       } else {
         dups.emplace_back(uint32_t(i), j);
       }
@@ -297,9 +339,7 @@ private:
 
   void compute_poles(size_t n, Progress &progress, std::vector<double> &poles,
                      sc_diag_t &diag) {
-    poles.assign(3 * n, 0.0);
-    const double kHull = std::numeric_limits<double>::infinity();
-    std::vector<double> best(n, -1.0);
+    const float kHull = std::numeric_limits<float>::infinity();
 
     // Samples on the convex hull: the pole is at infinity, in the direction
     // of the average outward normal of the hull facets around them.
@@ -310,64 +350,77 @@ private:
       V3 pts[3];
       V3 nrm = hull_normal(c, inf, pts);
       for (int k = 0; k < 3; ++k) {
-        uint32_t i = c->vertex((inf + 1 + k) % 4)->info();
-        double *p = &poles[3 * size_t(i)];
-        p[0] += nrm.x, p[1] += nrm.y, p[2] += nrm.z;
-        best[i] = kHull;
+        VertexData &d = c->vertex((inf + 1 + k) % 4)->info();
+        d.pole[0] += nrm.x, d.pole[1] += nrm.y, d.pole[2] += nrm.z;
+        d.best = kHull;
       }
     }
 
-    // Interior samples: the farthest Voronoi vertex of their cell.
+    // Interior samples: the farthest Voronoi vertex of their cell. Each
+    // cell keeps its circumcentre for the candidate pass.
     size_t cells = dt_.number_of_cells(), k = 0;
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
          ++c, ++k) {
       progress.tick(k, cells);
       ++diag.delaunay_cells;
       V3 cc = centre(c, &diag);
+      c->info().cc[0] = float(cc.x), c->info().cc[1] = float(cc.y),
+      c->info().cc[2] = float(cc.z);
       for (int j = 0; j < 4; ++j) {
-        uint32_t i = c->vertex(j)->info();
-        if (best[i] == kHull)
+        Vh v = c->vertex(j);
+        VertexData &d = v->info();
+        if (d.best == kHull)
           continue;
-        V3 d = cc - v3(c->vertex(j)->point());
-        double d2 = norm2(d);
-        if (d2 > best[i]) {
-          best[i] = d2;
-          double *p = &poles[3 * size_t(i)];
-          p[0] = d.x, p[1] = d.y, p[2] = d.z;
+        V3 dv = cc - v3(v->point());
+        float d2 = float(norm2(dv));
+        if (d2 > d.best) {
+          d.best = d2;
+          d.pole[0] = dv.x, d.pole[1] = dv.y, d.pole[2] = dv.z;
         }
       }
     }
-    for (size_t i = 0; i < n; ++i) {
-      if (best[i] == kHull)
+    // Unit poles, also copied out by input index: the triangulation is gone
+    // before the normals are made.
+    poles.assign(3 * n, 0.0);
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v) {
+      VertexData &d = v->info();
+      if (d.best == kHull)
         ++diag.hull_vertices;
-      double *p = &poles[3 * i];
-      double l = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+      double l = std::sqrt(d.pole[0] * d.pole[0] + d.pole[1] * d.pole[1] +
+                           d.pole[2] * d.pole[2]);
       if (l > 0)
-        p[0] /= l, p[1] /= l, p[2] /= l;
+        d.pole[0] /= l, d.pole[1] /= l, d.pole[2] /= l;
+      std::memcpy(&poles[3 * size_t(d.idx)], d.pole, sizeof d.pole);
     }
   }
 
   void select_candidates(const sc_params_t &params, Progress &progress,
-                         const std::vector<double> &poles,
                          std::vector<uint32_t> &tris, sc_diag_t &diag) {
     Criteria cr(params);
     size_t cells = dt_.number_of_cells(), k = 0;
-    V3 P[3];
+    V3 P[3], poles[3];
     uint32_t idx[3];
+    const Vh inf = dt_.infinite_vertex();
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
          ++c, ++k) {
       progress.tick(k, cells);
-      V3 cc = centre(c, nullptr);
+      const float *ccc = c->info().cc;
+      V3 cc = {ccc[0], ccc[1], ccc[2]};
       for (int f = 0; f < 4; ++f) {
         Ch nb = c->neighbor(f);
-        bool ray = dt_.is_infinite(nb);
-        if (!ray && &*nb < &*c)
-          continue; // the facet is handled from the other cell
+        // Each facet between two finite cells is handled from the cell at
+        // the lower address; that comparison needs no access to nb.
+        if (&*nb < &*c && !nb->has_vertex(inf))
+          continue;
+        bool ray = nb->has_vertex(inf);
         ++diag.delaunay_facets;
         for (int j = 0; j < 3; ++j) {
           Vh v = c->vertex((f + 1 + j) % 4);
+          const VertexData &d = v->info();
           P[j] = v3(v->point());
-          idx[j] = v->info();
+          poles[j] = {d.pole[0], d.pole[1], d.pole[2]};
+          idx[j] = d.idx;
         }
         V3 other;
         if (ray) {
@@ -376,9 +429,10 @@ private:
           V3 o = v3(c->vertex(f)->point());
           other = dot(nrm, o - P[0]) > 0 ? -1.0 * nrm : nrm;
         } else {
-          other = centre(nb, nullptr);
+          const float *oc = nb->info().cc;
+          other = {oc[0], oc[1], oc[2]};
         }
-        if (is_candidate(cr, P, idx, poles.data(), cc, other, ray)) {
+        if (is_candidate(cr, P, poles, cc, other, ray)) {
           tris.push_back(idx[0]);
           tris.push_back(idx[1]);
           tris.push_back(idx[2]);

@@ -60,10 +60,13 @@ private:
 
 // What the triangulation stages hand to the rest of the pipeline; the
 // triangulation itself is gone by then.
+// Vertices are numbered 0 .. m-1 in the triangulation's (spatially sorted)
+// order; to_input maps them back to input indices.
 struct Filtered {
-  std::vector<uint32_t> tris;   // candidate triangles, 3 indices each
-  std::vector<double> poles;    // 3 per input point: pole vector, not unit
-  std::vector<std::pair<uint32_t, uint32_t>> dups; // (duplicate, first)
+  std::vector<uint32_t> tris;     // candidate triangles, 3 vertex numbers each
+  std::vector<double> poles;      // 3 per vertex: unit pole direction
+  std::vector<uint32_t> to_input; // vertex number -> input index
+  std::vector<std::pair<uint32_t, uint32_t>> dups; // (duplicate, first), input
 };
 
 // The Delaunay-dependent stages, behind an interface so that the sequential

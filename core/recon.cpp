@@ -118,23 +118,30 @@ sc_mesh_t *Recon::finish() {
 
   Stopwatch sw;
   progress.stage(SC_STAGE_PRUNE);
+  // The points in vertex order, for locality (see Filtered).
+  const size_t m = f.to_input.size();
+  std::vector<double> lxyz(3 * m);
+  for (size_t k = 0; k < m; ++k)
+    std::memcpy(&lxyz[3 * k], xyz_ + 3 * size_t(f.to_input[k]),
+                3 * sizeof(double));
   std::vector<uint8_t> alive;
-  prune(xyz_, n_, f.tris, params_.paper_pruning != 0, alive, progress, diag);
+  prune(lxyz.data(), m, f.tris, params_.paper_pruning != 0, alive, progress,
+        diag);
   seconds_[SC_STAGE_PRUNE] += sw.lap();
 
   progress.stage(SC_STAGE_EXTRACT);
   Surface surf;
-  extract(xyz_, n_, f.tris, alive, size_t(params_.max_hole_edges), progress,
-          surf, diag);
+  extract(lxyz.data(), m, f.tris, alive, size_t(params_.max_hole_edges),
+          progress, surf, diag);
 
   // Per-vertex normals: the pole direction, signed to agree with the
   // area-weighted normal of the output triangles around the vertex.
-  std::vector<double> acc(3 * n_, 0.0);
+  std::vector<double> acc(3 * m, 0.0);
   const size_t nt = surf.tris.size() / 3;
   for (size_t t = 0; t < nt; ++t) {
     const uint32_t *v = &surf.tris[3 * t];
-    const double *a = xyz_ + 3 * size_t(v[0]), *b = xyz_ + 3 * size_t(v[1]),
-                 *c = xyz_ + 3 * size_t(v[2]);
+    const double *a = &lxyz[3 * size_t(v[0])], *b = &lxyz[3 * size_t(v[1])],
+                 *c = &lxyz[3 * size_t(v[2])];
     double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     double nrm[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
@@ -143,7 +150,7 @@ sc_mesh_t *Recon::finish() {
       for (int j = 0; j < 3; ++j)
         acc[3 * size_t(v[k]) + j] += nrm[j];
   }
-  for (size_t i = 0; i < n_; ++i) {
+  for (size_t i = 0; i < m; ++i) {
     double *a = &acc[3 * i];
     const double *p = &f.poles[3 * i];
     double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
@@ -157,9 +164,17 @@ sc_mesh_t *Recon::finish() {
       a[0] /= la, a[1] /= la, a[2] /= la;
     }
   }
+  // Back to input indices.
+  lxyz = std::vector<double>();
+  std::vector<double> normals(3 * n_, 0.0);
+  for (size_t k = 0; k < m; ++k)
+    std::memcpy(&normals[3 * size_t(f.to_input[k])], &acc[3 * k],
+                3 * sizeof(double));
   for (auto &d : f.dups)
     for (int j = 0; j < 3; ++j)
-      acc[3 * size_t(d.first) + j] = acc[3 * size_t(d.second) + j];
+      normals[3 * size_t(d.first) + j] = normals[3 * size_t(d.second) + j];
+  for (uint32_t &v : surf.tris)
+    v = f.to_input[v];
   seconds_[SC_STAGE_EXTRACT] += sw.lap();
 
   for (int s = 0; s < SC_STAGE_COUNT; ++s) {
@@ -168,23 +183,23 @@ sc_mesh_t *Recon::finish() {
   }
   progress.report(1.0);
 
-  sc_mesh_t *m = static_cast<sc_mesh_t *>(std::calloc(1, sizeof *m));
-  if (!m)
+  sc_mesh_t *out = static_cast<sc_mesh_t *>(std::calloc(1, sizeof *out));
+  if (!out)
     throw std::bad_alloc();
   try {
-    m->triangles = copy_out(surf.tris.data(), surf.tris.size());
-    m->triangle_count = nt;
-    m->normals = copy_out(acc.data(), acc.size());
-    m->point_count = n_;
-    m->component_genus =
+    out->triangles = copy_out(surf.tris.data(), surf.tris.size());
+    out->triangle_count = nt;
+    out->normals = copy_out(normals.data(), normals.size());
+    out->point_count = n_;
+    out->component_genus =
         copy_out(surf.component_genus.data(), surf.component_genus.size());
-    m->component_count = surf.component_genus.size();
-    m->diag = diag;
+    out->component_count = surf.component_genus.size();
+    out->diag = diag;
   } catch (...) {
-    sc_mesh_free(m);
+    sc_mesh_free(out);
     throw;
   }
-  return m;
+  return out;
 }
 
 } // namespace sc

@@ -1,0 +1,345 @@
+// shortcrust-bench: times each stage of the reconstruction on generated
+// samples and compares it, in the same run and on the same points, with
+// CGAL's Delaunay construction alone (time and peak memory) and with CGAL's
+// advancing-front reconstruction (the peer). Each measurement runs in a
+// forked child, so every peak-memory figure is that measurement's own.
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+
+#include <CGAL/Advancing_front_surface_reconstruction.h>
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "shortcrust.h"
+#include "testsupport.h"
+
+namespace {
+
+typedef CGAL::Exact_predicates_inexact_constructions_kernel K;
+typedef K::Point_3 Point;
+
+struct Result {
+  int ok;
+  double seconds;
+  double cpu_seconds; // user + system time of the measurement's process
+  double stage[SC_STAGE_COUNT];
+  double peak_bytes; // above the resident set at the start
+  uint64_t triangles, unused, components, boundary_edges;
+  int closed, manifold;
+  int64_t genus;
+  int mesh; // the fields above describe an output mesh
+};
+
+double now() {
+  using namespace std::chrono;
+  return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+double cpu_now() {
+  struct rusage ru;
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+         1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+long status_kb(const char *key) {
+  FILE *f = std::fopen("/proc/self/status", "r");
+  if (!f)
+    return -1;
+  char line[256];
+  long v = -1;
+  size_t k = std::strlen(key);
+  while (std::fgets(line, sizeof line, f))
+    if (std::strncmp(line, key, k) == 0 && line[k] == ':')
+      v = std::strtol(line + k + 1, nullptr, 10);
+  std::fclose(f);
+  return v;
+}
+
+// Resets the peak resident set to the current one (Linux 4.0+), so that
+// VmHWM then measures only what follows.
+void reset_peak() {
+  FILE *f = std::fopen("/proc/self/clear_refs", "w");
+  if (f) {
+    std::fputs("5", f);
+    std::fclose(f);
+  }
+}
+
+// Runs f in a child process and returns what it reported through a pipe.
+template <class F> Result in_child(F f) {
+  Result r{};
+  int fd[2];
+  if (pipe(fd) != 0)
+    return r;
+  std::fflush(nullptr);
+  pid_t pid = fork();
+  if (pid == 0) {
+    close(fd[0]);
+    reset_peak();
+    long base = status_kb("VmRSS");
+    double cpu0 = cpu_now();
+    Result res{};
+    f(res);
+    res.cpu_seconds = cpu_now() - cpu0;
+    res.peak_bytes = 1024.0 * double(status_kb("VmHWM") - base);
+    ssize_t w = write(fd[1], &res, sizeof res);
+    _exit(w == sizeof res ? 0 : 1);
+  }
+  close(fd[1]);
+  ssize_t got = read(fd[0], &r, sizeof r);
+  close(fd[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (got != sizeof r || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    r.ok = 0;
+  return r;
+}
+
+void check_mesh(size_t n, const double *xyz, const uint32_t *tri, size_t nt,
+                Result &r) {
+  sc_meshcheck_t c;
+  if (sc_meshcheck(n, xyz, tri, nt, nullptr, &c) != 0)
+    return;
+  r.triangles = c.faces;
+  r.unused = c.samples_unused;
+  r.components = c.components;
+  r.boundary_edges = c.boundary_edges;
+  r.closed = c.closed;
+  r.manifold = c.manifold;
+  r.genus = c.genus_total;
+  r.mesh = 1;
+  sc_meshcheck_free(&c);
+}
+
+Result run_cgal_delaunay(const double *xyz, size_t n) {
+  return in_child([&](Result &r) {
+    double t0 = now();
+    std::vector<Point> pts;
+    pts.reserve(n);
+    for (size_t i = 0; i < n; ++i)
+      pts.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    CGAL::Delaunay_triangulation_3<K> dt(pts.begin(), pts.end());
+    r.seconds = now() - t0;
+    r.ok = dt.dimension() == 3;
+  });
+}
+
+Result run_shortcrust(const double *xyz, size_t n, int threads) {
+  return in_child([&](Result &r) {
+    sc_params_t p;
+    sc_params_init(&p);
+    p.threads = threads;
+    sc_mesh_t *m = nullptr;
+    double t0 = now();
+    int rc = sc_reconstruct(xyz, n, &p, &m, nullptr, 0);
+    r.seconds = now() - t0;
+    if (rc != 0)
+      return;
+    for (int s = 0; s < SC_STAGE_COUNT; ++s)
+      r.stage[s] = m->diag.seconds[s];
+    check_mesh(n, xyz, m->triangles, m->triangle_count, r);
+    r.ok = 1;
+    sc_mesh_free(m);
+  });
+}
+
+Result run_advancing_front(const double *xyz, size_t n) {
+  return in_child([&](Result &r) {
+    double t0 = now();
+    std::vector<Point> pts;
+    pts.reserve(n);
+    for (size_t i = 0; i < n; ++i)
+      pts.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    std::vector<std::array<std::size_t, 3>> facets;
+    CGAL::advancing_front_surface_reconstruction(pts.begin(), pts.end(),
+                                                 std::back_inserter(facets));
+    r.seconds = now() - t0;
+    std::vector<uint32_t> tri;
+    tri.reserve(3 * facets.size());
+    for (const auto &f : facets)
+      for (std::size_t v : f)
+        tri.push_back(uint32_t(v));
+    check_mesh(n, xyz, tri.data(), facets.size(), r);
+    r.ok = 1;
+  });
+}
+
+void usage(FILE *f) {
+  std::fprintf(
+      f,
+      "usage: shortcrust-bench [--sizes N,N,...] [--surface NAME] "
+      "[--density NAME]\n"
+      "                        [--threads N] [--no-peer] [--peer-max N] "
+      "[--seed S]\n\n"
+      "Times the reconstruction stage by stage on generated samples and "
+      "prints, per size,\n"
+      "its time and peak memory against CGAL's Delaunay construction of "
+      "the same points\n"
+      "alone, the gain of the parallel triangulation, and CGAL's "
+      "advancing-front\n"
+      "reconstruction of the same points (time, and whether it is "
+      "closed).\n\n"
+      "  --sizes      point counts (default 100000,1000000)\n"
+      "  --surface    sphere, ellipsoid, torus, genus2, two-spheres, "
+      "nested-spheres\n"
+      "               (default torus)\n"
+      "  --density    uniform-random, uniform, adaptive (default "
+      "uniform-random)\n"
+      "  --threads    threads for the parallel run (default: one per core)\n"
+      "  --no-peer    skip the advancing front\n"
+      "  --peer-max   run the advancing front only up to this many points\n"
+      "               (default 1000000)\n"
+      "  --seed       sample seed (default 1)\n");
+}
+
+void print_row(const char *name, const Result &r, size_t n) {
+  if (!r.ok) {
+    std::printf("  %-28s failed\n", name);
+    return;
+  }
+  std::printf("  %-24s %8.3f s (cpu %7.3f s)  peak %5.0f B/point", name,
+              r.seconds, r.cpu_seconds, r.peak_bytes / double(n));
+  if (r.mesh)
+    std::printf("  %llu triangles, %s, %llu component%s, genus %lld, %llu "
+                "unused",
+                (unsigned long long)r.triangles,
+                r.closed ? "closed" : r.manifold ? "open" : "not manifold",
+                (unsigned long long)r.components,
+                r.components == 1 ? "" : "s", (long long)r.genus,
+                (unsigned long long)r.unused);
+  std::printf("\n");
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  std::vector<size_t> sizes{100000, 1000000};
+  int surface = SC_SURF_TORUS, density = SC_DENSITY_UNIFORM_RANDOM;
+  int threads = int(std::thread::hardware_concurrency());
+  bool peer = true;
+  size_t peer_max = 1000000;
+  uint64_t seed = 1;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&]() -> const char * {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "shortcrust-bench: %s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--sizes") {
+      sizes.clear();
+      std::string s = value();
+      for (size_t at = 0; at <= s.size();) {
+        size_t comma = s.find(',', at);
+        if (comma == std::string::npos)
+          comma = s.size();
+        long v = std::atol(s.substr(at, comma - at).c_str());
+        if (v < 4) {
+          std::fprintf(stderr, "shortcrust-bench: bad size in '%s'\n",
+                       s.c_str());
+          return 2;
+        }
+        sizes.push_back(size_t(v));
+        at = comma + 1;
+      }
+    } else if (a == "--surface") {
+      surface = sc_surface_from_name(value());
+    } else if (a == "--density") {
+      density = sc_density_from_name(value());
+    } else if (a == "--threads") {
+      threads = std::atoi(value());
+    } else if (a == "--no-peer") {
+      peer = false;
+    } else if (a == "--peer-max") {
+      peer_max = size_t(std::atol(value()));
+    } else if (a == "--seed") {
+      seed = std::strtoull(value(), nullptr, 10);
+    } else if (a == "-h" || a == "--help") {
+      usage(stdout);
+      return 0;
+    } else {
+      std::fprintf(stderr, "shortcrust-bench: unknown option '%s'\n",
+                   a.c_str());
+      usage(stderr);
+      return 2;
+    }
+  }
+  if (surface < 0 || density < 0 || threads < 1) {
+    std::fprintf(stderr, "shortcrust-bench: bad --surface, --density or "
+                         "--threads\n");
+    return 2;
+  }
+
+  for (size_t n : sizes) {
+    std::vector<double> xyz(3 * n);
+    double t0 = now();
+    if (sc_sample_surface(sc_surface_t(surface), density, n, seed,
+                          xyz.data()) != 0) {
+      std::fprintf(stderr, "shortcrust-bench: sampling failed\n");
+      return 1;
+    }
+    std::printf("%zu points, %s, %s (sampled in %.1f s)\n", n,
+                sc_surface_name(sc_surface_t(surface)),
+                sc_density_name(density), now() - t0);
+    Result dt = run_cgal_delaunay(xyz.data(), n);
+    print_row("cgal delaunay alone", dt, n);
+    Result one = run_shortcrust(xyz.data(), n, 1);
+    print_row("shortcrust, 1 thread", one, n);
+    if (one.ok) {
+      std::printf("    stages:");
+      for (int s = 0; s < SC_STAGE_COUNT; ++s)
+        std::printf(" %s %.3f s%s", sc_stage_name(s), one.stage[s],
+                    s + 1 < SC_STAGE_COUNT ? "," : "\n");
+    }
+    Result par{};
+    if (threads > 1) {
+      par = run_shortcrust(xyz.data(), n, threads);
+      char name[64];
+      std::snprintf(name, sizeof name, "shortcrust, %d threads", threads);
+      print_row(name, par, n);
+      if (par.ok)
+        std::printf("    delaunay stage %.3f s (%.2fx of 1 thread)\n",
+                    par.stage[SC_STAGE_DELAUNAY],
+                    par.stage[SC_STAGE_DELAUNAY] /
+                        one.stage[SC_STAGE_DELAUNAY]);
+    }
+    Result af{};
+    if (peer && n <= peer_max) {
+      af = run_advancing_front(xyz.data(), n);
+      print_row("cgal advancing front", af, n);
+    }
+    if (dt.ok && one.ok) {
+      // CPU time is what a busy machine disturbs least; the single-thread
+      // runs use one core, so it is their cost.
+      std::printf("  ratios: time / cgal delaunay %.2f (cpu %.2f; target <= "
+                  "1.5 at 1M), peak memory / cgal delaunay %.2f (target <= "
+                  "1.3)",
+                  one.seconds / dt.seconds, one.cpu_seconds / dt.cpu_seconds,
+                  one.peak_bytes / dt.peak_bytes);
+      if (par.ok)
+        std::printf(", %d threads / 1 thread %.2f", threads,
+                    par.seconds / one.seconds);
+      if (af.ok)
+        std::printf(", advancing front / shortcrust %.1f",
+                    af.seconds / one.seconds);
+      std::printf("\n\n");
+    }
+  }
+  return 0;
+}
