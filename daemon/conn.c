@@ -46,6 +46,8 @@ static size_t queued(const scd_conn_t *c) {
   return c->out.len + (c->writing ? c->wbuf.len : 0);
 }
 
+size_t scd_conn_queued(const scd_conn_t *c) { return queued(c); }
+
 static int live(const scd_conn_t *c) {
   return c->state == SCD_CONN_HANDSHAKE || c->state == SCD_CONN_READY;
 }

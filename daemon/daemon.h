@@ -78,7 +78,8 @@ typedef struct scd_server {
   char lock_path[272];
 
   uv_signal_t sigterm, sigint;
-  uv_timer_t tick;         /* once a second: timeouts and the grace period */
+  uv_timer_t tick;         /* once a second: timeouts */
+  uv_timer_t grace;        /* ends the grace period of a shutdown */
   scd_pool_t *pool;
 
   scd_conn_t *conns;       /* every open connection */
@@ -178,6 +179,8 @@ void scd_conn_task_event(scd_server_t *srv, scd_task_t *t, unsigned events,
 void scd_conn_shutdown(scd_conn_t *c);
 void scd_conn_tick(scd_conn_t *c, uint64_t now);
 void scd_conn_close_now(scd_conn_t *c, const char *reason);
+/* Output bytes queued on the connection, written or waiting. */
+size_t scd_conn_queued(const scd_conn_t *c);
 
 /* listen.c */
 int scd_listen_open(scd_server_t *srv);

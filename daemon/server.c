@@ -78,6 +78,9 @@ void scd_server_stats(scd_server_t *srv, scp_buf_t *b, uint32_t tag) {
   scd_pool_stats_t ps;
   scd_pool_get_stats(srv->pool, &ps);
   const scd_counters_t *n = &srv->n;
+  uint64_t out_queued = 0;
+  for (const scd_conn_t *c = srv->conns; c; c = c->next)
+    out_queued += scd_conn_queued(c);
 #define U64(name_, value_)                                                     \
   {.name = name_, .kind = SCP_KIND_U64, .v.u = (uint64_t)(value_)}
   scp_value_t v[] = {
@@ -103,6 +106,7 @@ void scd_server_stats(scd_server_t *srv, scp_buf_t *b, uint32_t tag) {
       U64("workers_busy", ps.busy),
       U64("memory_jobs_bytes", srv->budget_used),
       U64("memory_budget_bytes", srv->cfg.memory_budget),
+      U64("output_queued_bytes", out_queued),
       U64("shutting_down", srv->shutting_down),
   };
 #undef U64
@@ -122,6 +126,7 @@ void scd_server_maybe_finish(scd_server_t *srv) {
   close_handle((uv_handle_t *)&srv->sigterm);
   close_handle((uv_handle_t *)&srv->sigint);
   close_handle((uv_handle_t *)&srv->tick);
+  close_handle((uv_handle_t *)&srv->grace);
   scd_pool_close(srv->pool);
 }
 
@@ -138,6 +143,8 @@ static void end_grace(scd_server_t *srv) {
 }
 
 static void on_listener_closed(uv_handle_t *h) { (void)h; }
+
+static void on_grace(uv_timer_t *h) { end_grace(h->data); }
 
 static void begin_shutdown(scd_server_t *srv, const char *why) {
   if (srv->shutting_down) {
@@ -164,6 +171,8 @@ static void begin_shutdown(scd_server_t *srv, const char *why) {
   }
   if (srv->cfg.grace <= 0)
     end_grace(srv);
+  else
+    uv_timer_start(&srv->grace, on_grace, (uint64_t)(srv->cfg.grace * 1e3), 0);
   scd_server_maybe_finish(srv);
 }
 
@@ -174,8 +183,6 @@ static void on_signal(uv_signal_t *h, int signum) {
 static void on_tick(uv_timer_t *h) {
   scd_server_t *srv = h->data;
   uint64_t now = uv_hrtime();
-  if (srv->shutting_down && !srv->grace_over && now >= srv->grace_deadline_ns)
-    end_grace(srv);
   for (scd_conn_t *c = srv->conns, *next; c; c = next) {
     next = c->next;
     if (srv->shutting_down && now >= srv->final_deadline_ns)
@@ -273,6 +280,8 @@ int scd_server_run(const scd_config_t *cfg) {
   uv_timer_init(srv->loop, &srv->tick);
   srv->tick.data = srv;
   uv_timer_start(&srv->tick, on_tick, 1000, 1000);
+  uv_timer_init(srv->loop, &srv->grace);
+  srv->grace.data = srv;
 
   char budget[32];
   snprintf(budget, sizeof budget, "%.1f MiB",

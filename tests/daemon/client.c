@@ -217,8 +217,11 @@ int scdt_handshake_v(scdt_conn_t *c, uint16_t vmin, uint16_t vmax,
                    .version_max = vmax,
                    .features = 0,
                    .max_frame = max_frame};
-  if (scp_enc_hello(&c->out, &h) != 0 || scdt_flush(c, timeout_ms) != 0)
+  if (scp_enc_hello(&c->out, &h) != 0)
     return -1;
+  /* A server that refuses us may close before it reads the HELLO; its
+   * ERROR is still there to read. */
+  scdt_flush(c, timeout_ms);
   scdt_frame_t *f = scdt_recv(c, timeout_ms);
   if (!f)
     return -1;
@@ -484,10 +487,16 @@ static int collect_one(scdt_conn_t *c, scdt_job_t **jobs, size_t njobs,
 
 int scdt_collect(scdt_conn_t *c, scdt_job_t **jobs, size_t njobs,
                  int timeout_ms, char *why, size_t why_len) {
+  return scdt_collect_some(c, jobs, njobs, njobs, timeout_ms, why, why_len);
+}
+
+int scdt_collect_some(scdt_conn_t *c, scdt_job_t **jobs, size_t njobs,
+                      size_t nwait, int timeout_ms, char *why,
+                      size_t why_len) {
   uint64_t deadline = scdt_now_ms() + (uint64_t)timeout_ms;
   for (;;) {
     size_t open = 0;
-    for (size_t i = 0; i < njobs; i++)
+    for (size_t i = 0; i < nwait; i++)
       open += !jobs[i]->ended;
     if (!open)
       return 0;

@@ -114,6 +114,11 @@ int scdt_job_send(scdt_conn_t *c, scdt_job_t *j);
  */
 int scdt_collect(scdt_conn_t *c, scdt_job_t **jobs, size_t njobs,
                  int timeout_ms, char *why, size_t why_len);
+/* The same, but returns once the first nwait jobs of jobs[] have ended;
+ * the others are in use and may get frames meanwhile. */
+int scdt_collect_some(scdt_conn_t *c, scdt_job_t **jobs, size_t njobs,
+                      size_t nwait, int timeout_ms, char *why,
+                      size_t why_len);
 
 /* STATS_REQUEST on c, then the value called name: 0 or -1. Frames of
  * other kinds that arrive first are dropped. */

@@ -1,0 +1,141 @@
+/*
+ * SIGTERM and SIGINT: the daemon stops accepting, lets running jobs finish
+ * within --grace, ends queued jobs with SHUTDOWN, closes every connection
+ * with a fatal SHUTDOWN, removes its socket file and exits 0. A job still
+ * running when the grace period ends gets SHUTDOWN too.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "harness.h"
+#include "testsupport.h"
+
+#define T_MS 120000
+
+static int exists(const char *path) {
+  struct stat st;
+  return lstat(path, &st) == 0;
+}
+
+/* One worker: a job runs, another waits behind it, and a third is still
+ * uploading on another connection when SIGTERM comes. */
+static void running_and_queued(void) {
+  scdt_daemon_t d;
+  const char *args[] = {"--workers", "1", "--grace", "60", NULL};
+  REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
+  size_t big = 30000;
+  double *xyz = scdt_sample(SC_SURF_SPHERE, big, 1);
+  double *small = scdt_sample(SC_SURF_TORUS, 3000, 2);
+  scdt_conn_t *a, *b;
+  REQUIRE(scdt_open(d.sock, 1u << 20, &a) == 0, "a");
+  REQUIRE(scdt_open(d.sock, 1u << 20, &b) == 0, "b");
+  scdt_job_t run, queued, uploading;
+  scdt_job_init(&run, 1, xyz, big);
+  scdt_job_init(&queued, 2, small, 3000);
+  scdt_job_init(&uploading, 3, small, 3000);
+  CHECK(scdt_job_send(a, &run) == 0, "send");
+  CHECK_EQ(scdt_stat_wait(d.sock, "workers_busy", 1, T_MS), 1);
+  CHECK(scdt_job_send(a, &queued) == 0, "send");
+  CHECK(scdt_job_begin(b, &uploading) == 0 &&
+            scdt_job_points(b, &uploading, 1000) == 0,
+        "send");
+  CHECK_EQ(scdt_stat_wait(d.sock, "queue_depth", 1, T_MS), 1);
+  CHECK_EQ(scdt_stat_fresh(d.sock, "workers_busy"), 1);
+
+  kill(d.pid, SIGTERM);
+  scdt_job_t *pa[2] = {&run, &queued}, *pb = &uploading;
+  char why[512] = "";
+  CHECK(scdt_collect(a, pa, 2, T_MS, why, sizeof why) == 0, "%s", why);
+  CHECK(scdt_collect(b, &pb, 1, T_MS, why, sizeof why) == 0, "%s", why);
+  CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &run, why, sizeof why),
+        "the running job must finish: %s", why);
+  CHECK(queued.error_code == SCP_WIRE_SHUTDOWN,
+        "queued job: want SHUTDOWN, got %s", scp_wire_name(queued.error_code));
+  CHECK(uploading.error_code == SCP_WIRE_SHUTDOWN,
+        "uploading job: want SHUTDOWN, got %s",
+        scp_wire_name(uploading.error_code));
+  printf("queued job: %s\n", queued.error_msg);
+  /* Then each connection gets a fatal SHUTDOWN and is closed. */
+  CHECK(scdt_wait_closed(a, T_MS), "a not closed");
+  CHECK(a->got_error && a->last_error.code == SCP_WIRE_SHUTDOWN &&
+            (a->last_error.flags & SCP_ERROR_FATAL),
+        "a: want a fatal SHUTDOWN");
+  CHECK(scdt_wait_closed(b, T_MS), "b not closed");
+  CHECK(b->got_error && b->last_error.code == SCP_WIRE_SHUTDOWN,
+        "b: want SHUTDOWN");
+  CHECK_EQ(scdt_daemon_wait(&d, T_MS), 0);
+  CHECK(!exists(d.sock), "socket file %s left behind", d.sock);
+  char lock[200];
+  snprintf(lock, sizeof lock, "%s.lock", d.sock);
+  CHECK(!exists(lock), "lock file %s left behind", lock);
+  scdt_conn_t *late;
+  CHECK(scdt_connect(d.sock, &late) != 0, "connected after shutdown");
+  scdt_job_reset(&run);
+  scdt_job_reset(&queued);
+  scdt_job_reset(&uploading);
+  scdt_close(a);
+  scdt_close(b);
+  free(xyz);
+  free(small);
+}
+
+/* A job that cannot finish within the grace period. */
+static void grace_over(void) {
+  scdt_daemon_t d;
+  const char *args[] = {"--workers", "1", "--grace", "0.2", NULL};
+  REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
+  size_t big = 60000;
+  double *xyz = scdt_sample(SC_SURF_SPHERE, big, 3);
+  scdt_conn_t *a;
+  REQUIRE(scdt_open(d.sock, 1u << 20, &a) == 0, "a");
+  scdt_job_t run;
+  scdt_job_init(&run, 1, xyz, big);
+  CHECK(scdt_job_send(a, &run) == 0, "send");
+  CHECK_EQ(scdt_stat_wait(d.sock, "workers_busy", 1, T_MS), 1);
+  uint64_t t0 = scdt_now_ms();
+  kill(d.pid, SIGINT);
+  scdt_job_t *pa = &run;
+  char why[512] = "";
+  CHECK(scdt_collect(a, &pa, 1, T_MS, why, sizeof why) == 0, "%s", why);
+  CHECK(run.error_code == SCP_WIRE_SHUTDOWN, "want SHUTDOWN, got %s",
+        run.done ? "JOB_DONE" : scp_wire_name(run.error_code));
+  printf("job ended %llu ms after SIGINT: %s\n",
+         (unsigned long long)(scdt_now_ms() - t0), run.error_msg);
+  CHECK(scdt_wait_closed(a, T_MS), "not closed");
+  CHECK_EQ(scdt_daemon_wait(&d, T_MS), 0);
+  CHECK(!exists(d.sock), "socket file left behind");
+  scdt_job_reset(&run);
+  scdt_close(a);
+  free(xyz);
+}
+
+/* Idle, and a connection that never said HELLO. */
+static void idle(void) {
+  scdt_daemon_t d;
+  REQUIRE(scdt_daemon_start(&d, NULL) == 0, "daemon did not start");
+  scdt_conn_t *c;
+  REQUIRE(scdt_connect(d.sock, &c) == 0, "connect");
+  CHECK_EQ(scdt_stat_wait(d.sock, "connections", 2, T_MS), 2);
+  kill(d.pid, SIGTERM);
+  CHECK(scdt_wait_closed(c, T_MS), "not closed");
+  CHECK(c->got_error && c->last_error.code == SCP_WIRE_SHUTDOWN,
+        "want SHUTDOWN before the handshake");
+  CHECK_EQ(scdt_daemon_wait(&d, T_MS), 0);
+  CHECK(!exists(d.sock), "socket file left behind");
+  CHECK(scdt_log_contains(&d, "SIGTERM: shutting down"), "no log line");
+  scdt_close(c);
+}
+
+int main(int argc, char **argv) {
+  scdt_init(argc, argv);
+  idle();
+  running_and_queued();
+  grace_over();
+  return scdt_finish();
+}
