@@ -4,7 +4,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 
-.PHONY: all setup configure build test test-sanitize demo bench clean
+.PHONY: all setup configure build test test-sanitize test-tsan fuzz demo bench clean
 
 all: build
 
@@ -29,6 +29,19 @@ test-sanitize: setup
 	cmake --build $(BUILD)-asan -j $(JOBS)
 	cd $(BUILD)-asan && ctest --output-on-failure -j $(JOBS) -LE slow
 
+# ThreadSanitizer build of the threaded code's fast tests: the daemon's pool
+# and the clients (TBB, under the parallel triangulation, is not
+# instrumented, so the core stays out).
+test-tsan: setup
+	cmake -S . -B $(BUILD)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSC_SANITIZE=thread
+	cmake --build $(BUILD)-tsan -j $(JOBS)
+	cd $(BUILD)-tsan && ctest --output-on-failure -j $(JOBS) -LE slow -R '^(daemon|clients)_'
+
+# The protocol decoder under libFuzzer, ASan and UBSan (clang), for FUZZ_SECONDS.
+FUZZ_SECONDS ?= 60
+fuzz: setup
+	bash tests/proto/run-fuzz.sh $(BUILD)-fuzz $(FUZZ_SECONDS)
+
 demo: build
 	bash scripts/demo.sh $(BUILD)
 
@@ -36,4 +49,4 @@ bench: build
 	$(BUILD)/bin/shortcrust-bench
 
 clean:
-	rm -rf $(BUILD) $(BUILD)-asan $(BUILD)-tsan
+	rm -rf $(BUILD) $(BUILD)-asan $(BUILD)-tsan $(BUILD)-fuzz
