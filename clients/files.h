@@ -1,0 +1,161 @@
+/*
+ * Point and mesh files: the one place that reads and writes PLY, XYZ-like
+ * text, OFF, OBJ and STL, shared by the local command and the client.
+ *
+ * Readers stream the file through a fixed buffer, so a file is never held in
+ * memory whole, and they check every count a header declares against the
+ * file's size before allocating for it. Every failure returns a negative
+ * code and writes one line to the caller's message buffer naming the file,
+ * the line (text) or byte offset (binary) and what was expected there.
+ *
+ * Writers never leave a half-written file behind: they write a temporary
+ * file next to the target, flush it to disk and rename it over the target,
+ * so an existing target is either replaced whole or left as it was.
+ *
+ * Numbers in text files are parsed with strtod(), so the process must keep
+ * the "C" locale for LC_NUMERIC (the default unless setlocale() changes it).
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#ifndef SC_FILES_H
+#define SC_FILES_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/*
+ * Error codes, in a range of their own (-101 to -106) so that a program can
+ * report them next to the core's codes without confusing the two.
+ */
+#define SC_FILE_ERRNO_MAP(X)                                                   \
+  X(INVAL, -101, "invalid argument")                                           \
+  X(NOENT, -102, "no such file")                                               \
+  X(IO, -103, "input/output error")                                            \
+  X(FORMAT, -104, "malformed file")                                            \
+  X(UNSUPPORTED, -105, "unsupported file format")                              \
+  X(NOMEM, -106, "out of memory")
+
+typedef enum sc_file_err {
+  SC_FILE_OK = 0,
+#define SC_FILE_ERR_ENUM_(name, value, text) SC_FILE_E##name = (value),
+  SC_FILE_ERRNO_MAP(SC_FILE_ERR_ENUM_)
+#undef SC_FILE_ERR_ENUM_
+} sc_file_err_t;
+
+/* A fixed English description of a code; "unknown error" for other values. */
+const char *sc_file_strerror(int code);
+/* The code's name, e.g. "EFORMAT"; "UNKNOWN" for other values. */
+const char *sc_file_err_name(int code);
+
+/* Points as 3 * count doubles (x, y, z of each point in turn). */
+typedef struct sc_points {
+  double *xyz;
+  size_t count;
+} sc_points_t;
+
+/*
+ * Reads the points of a file into *out, choosing the format by the file's
+ * extension (case-insensitive):
+ *   .ply                      PLY, ascii or binary of either byte order: the
+ *                             x, y, z properties of the "vertex" element, of
+ *                             any scalar type; everything else is skipped,
+ *                             so a mesh file yields its vertices.
+ *   .xyz .txt .pts .csv       one point per line, the first three numbers
+ *                             separated by spaces, tabs or commas; further
+ *                             columns are ignored, as are blank lines and
+ *                             text after '#'. A .pts file may start with a
+ *                             line holding only the point count, and a .csv
+ *                             file with a line of column names; both are
+ *                             skipped.
+ *   .off                      OFF (also COFF, NOFF, CNOFF, STOFF): vertices.
+ *   .obj                      Wavefront OBJ: the 'v' lines.
+ * PLY and OFF files must start with their magic word. A non-finite number
+ * ("nan", "inf") is returned as it is; a token that is not a number is an
+ * error. A file without points is not an error: count is 0 and xyz NULL.
+ *
+ * On success returns 0 and fills *out, which the caller releases with
+ * sc_points_free(). On failure returns a negative SC_FILE_E* code, leaves
+ * *out zeroed, and writes a one-line message to msg (when msg_len > 0).
+ */
+int sc_points_read(const char *path, sc_points_t *out, char *msg,
+                   size_t msg_len);
+
+/* Releases the points and zeroes *p; accepts NULL and a zeroed struct. */
+void sc_points_free(sc_points_t *p);
+
+/*
+ * Reads a triangle mesh: vertices into *pts and 3 * *n_tri vertex indices
+ * into *tri (malloc'd; release with free()). Formats by extension: .ply
+ * (the "vertex" element and the "vertex_indices" or "vertex_index" list of
+ * the "face" element), .off, .obj ('v' and 'f' lines, negative indices
+ * counted back from the last vertex) and .stl (binary or ascii; STL has no
+ * shared vertices, so each triangle gets three vertices of its own, in
+ * file order). Polygons are split into a fan of triangles around their
+ * first vertex. A file without faces gives *n_tri == 0 and *tri == NULL.
+ * Failure as for sc_points_read(); *pts, *tri and *n_tri are then zeroed.
+ */
+int sc_mesh_read(const char *path, sc_points_t *pts, uint32_t **tri,
+                 size_t *n_tri, char *msg, size_t msg_len);
+
+/* Output formats of sc_mesh_write(). */
+typedef enum sc_mesh_format {
+  SC_MESH_FMT_AUTO = 0,   /* by the path's extension, binary PLY for .ply */
+  SC_MESH_FMT_PLY_BINARY, /* binary little-endian PLY */
+  SC_MESH_FMT_PLY_ASCII,
+  SC_MESH_FMT_OFF,
+  SC_MESH_FMT_OBJ,
+  SC_MESH_FMT_STL_BINARY,
+  SC_MESH_FMT_STL_ASCII
+} sc_mesh_format_t;
+
+/*
+ * The output format for a path's extension: .ply, .off, .obj or .stl (any
+ * case). With ascii non-zero, .ply and .stl give their ascii variant; OFF
+ * and OBJ are text in any case. Returns 0, or SC_FILE_EUNSUPPORTED with a
+ * message naming the extension.
+ */
+int sc_mesh_format_from_path(const char *path, int ascii,
+                             sc_mesh_format_t *fmt, char *msg,
+                             size_t msg_len);
+
+/*
+ * Writes n_points vertices (xyz, 3 * n_points doubles) and n_tri triangles
+ * (tri, 3 * n_tri indices into the vertices) to path, atomically.
+ *
+ * Every point is written, used by a triangle or not, so that indices keep
+ * their meaning. Coordinates are written exactly: as doubles in binary PLY
+ * and with 17 significant digits in text formats; binary STL stores floats.
+ * normals (3 * n_points doubles, or NULL) are written as PLY nx, ny, nz
+ * properties (float) and OBJ 'vn' lines (with faces 'f a//a b//b c//c');
+ * OFF has no place for them. STL facet normals are computed from each
+ * triangle, counter-clockwise meaning outward, and are zero for a triangle
+ * without area.
+ *
+ * Returns 0, or a negative code with a message: SC_FILE_EINVAL for an index
+ * not below n_points (nothing is written then), SC_FILE_EUNSUPPORTED for a
+ * mesh the format cannot hold, SC_FILE_EIO when creating, writing, syncing
+ * or renaming fails. On failure an existing file at path is left as it was
+ * and the temporary file is removed.
+ */
+int sc_mesh_write(const char *path, sc_mesh_format_t fmt, const double *xyz,
+                  size_t n_points, const uint32_t *tri, size_t n_tri,
+                  const double *normals, char *msg, size_t msg_len);
+
+/*
+ * Replaces the file at path with len bytes of data, atomically in the same
+ * way as sc_mesh_write() (for reports and other small outputs). A new file
+ * gets mode 0666 less the umask; a replaced file keeps its mode.
+ */
+int sc_file_write_atomic(const char *path, const void *data, size_t len,
+                         char *msg, size_t msg_len);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SC_FILES_H */
