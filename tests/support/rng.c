@@ -1,0 +1,48 @@
+/*
+ * xoshiro256** (Blackman and Vigna), seeded by splitmix64 so that nearby
+ * seeds such as 1 and 2 still give unrelated streams.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "testsupport.h"
+
+#include <time.h>
+
+static uint64_t splitmix64(uint64_t *x) {
+  uint64_t z = (*x += 0x9e3779b97f4a7c15ull);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+
+void sc_rng_seed(sc_rng_t *rng, uint64_t seed) {
+  uint64_t x = seed;
+  for (int i = 0; i < 4; i++)
+    rng->s[i] = splitmix64(&x);
+}
+
+uint64_t sc_rng_next(sc_rng_t *rng) {
+  uint64_t *s = rng->s;
+  uint64_t result = rotl(s[1] * 5, 7) * 9;
+  uint64_t t = s[1] << 17;
+  s[2] ^= s[0];
+  s[3] ^= s[1];
+  s[1] ^= s[2];
+  s[0] ^= s[3];
+  s[2] ^= t;
+  s[3] = rotl(s[3], 45);
+  return result;
+}
+
+double sc_rng_uniform(sc_rng_t *rng) {
+  return (double)(sc_rng_next(rng) >> 11) * 0x1.0p-53;
+}
+
+double sc_ts_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}

@@ -1,0 +1,95 @@
+/*
+ * Timings at full size: a million samples, and the checker on two million
+ * triangles. The times are printed for the log, not asserted (machines
+ * differ); what is asserted is that the results are still right at this
+ * size, where index widths and sort passes would show their limits.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "testsupport.h"
+#include "tsassert.h"
+
+#include <stdlib.h>
+
+static void time_sampling(sc_surface_t s, int d, size_t n) {
+  double *xyz = malloc(3 * n * sizeof *xyz);
+  if (!xyz)
+    abort();
+  double t0 = sc_ts_seconds();
+  int rc = sc_sample_surface(s, d, n, 1, xyz);
+  double t1 = sc_ts_seconds();
+  TS_EQ_I64(rc, SC_TS_OK);
+  double worst = 0;
+  for (size_t i = 0; i < n; i++) {
+    double dist = sc_surface_distance(s, xyz + 3 * i);
+    worst = dist > worst || dist != dist ? dist : worst;
+  }
+  TS_LE(worst, 1e-9);
+  printf("sample %s/%s, %zu points: %.3f s\n", sc_surface_name(s),
+         sc_density_name(d), n, t1 - t0);
+  free(xyz);
+}
+
+/* A torus as a U x V grid of quads, two triangles each, outward. */
+static void time_meshcheck(void) {
+  enum { U = 1000, V = 1000 };
+  const double pi = 3.14159265358979323846, R = 1, r = 0.35;
+  size_t n = (size_t)U * V, ntri = 2 * n;
+  double *xyz = malloc(3 * n * sizeof *xyz);
+  uint32_t *tri = malloc(3 * ntri * sizeof *tri);
+  if (!xyz || !tri)
+    abort();
+  for (uint32_t i = 0; i < U; i++)
+    for (uint32_t j = 0; j < V; j++) {
+      double u = 2 * pi * i / U, v = 2 * pi * j / V, rho = R + r * cos(v);
+      double *p = xyz + 3 * ((size_t)V * i + j);
+      p[0] = rho * cos(u);
+      p[1] = rho * sin(u);
+      p[2] = r * sin(v);
+    }
+  uint32_t *t = tri;
+  for (uint32_t i = 0; i < U; i++)
+    for (uint32_t j = 0; j < V; j++) {
+      uint32_t a = V * i + j, b = V * ((i + 1) % U) + j;
+      uint32_t c = V * ((i + 1) % U) + (j + 1) % V, d = V * i + (j + 1) % V;
+      uint32_t q[6] = {a, b, c, a, c, d};
+      for (int k = 0; k < 6; k++)
+        *t++ = q[k];
+    }
+  sc_meshcheck_t c;
+  double t0 = sc_ts_seconds();
+  int rc = sc_meshcheck(n, xyz, tri, ntri, NULL, &c);
+  double t1 = sc_ts_seconds();
+  TS_EQ_I64(rc, SC_TS_OK);
+  TS_EQ_U64(c.faces, ntri);
+  TS_EQ_U64(c.edges, 3 * n);
+  TS_EQ_U64(c.vertices_used, n);
+  TS_EQ_U64(c.components, 1);
+  TS_EQ_I64(c.genus_total, 1);
+  TS_TRUE(c.closed && c.oriented, "closed %d oriented %d", c.closed,
+          c.oriented);
+  char why[256];
+  TS_TRUE(sc_meshcheck_expect(&c, SC_SURF_TORUS,
+                              SC_EXPECT_ALL_USED | SC_EXPECT_OUTWARD, why,
+                              sizeof why),
+          "%s", why);
+  /* The inscribed polyhedron falls short of the torus by O(h^2). */
+  const sc_surface_info_t *info = sc_surface_info(SC_SURF_TORUS);
+  TS_NEAR(c.volume / info->volume[0], 1, 1e-4);
+  TS_NEAR(c.area / info->area, 1, 1e-4);
+  char line[512];
+  printf("meshcheck, %zu triangles: %.3f s\n  %s\n", ntri, t1 - t0,
+         sc_meshcheck_summary(&c, line, sizeof line));
+  sc_meshcheck_free(&c);
+  free(xyz);
+  free(tri);
+}
+
+int main(void) {
+  time_sampling(SC_SURF_SPHERE, SC_DENSITY_UNIFORM_RANDOM, 1000000);
+  time_sampling(SC_SURF_SPHERE, SC_DENSITY_UNIFORM, 1000000);
+  time_sampling(SC_SURF_TORUS, SC_DENSITY_ADAPTIVE, 1000000);
+  time_meshcheck();
+  return ts_exit_code();
+}
