@@ -199,7 +199,9 @@ static const char *phase_name(int phase) {
 static void log_job(scd_conn_t *c, scd_job_t *j, const char *outcome,
                     const char *detail) {
   uint64_t now = uv_hrtime();
-  const scd_task_t *t = j->task;
+  /* A task still in the pool is a worker's: its timings and mesh are not
+   * ours to read. */
+  const scd_task_t *t = j->task && !j->task->submitted ? j->task : NULL;
   const sc_mesh_t *m = t ? t->mesh : NULL;
   char stages[256] = "";
   if (m) {
@@ -954,13 +956,15 @@ static void on_points(scd_conn_t *c, const scp_frame_t *f) {
     uint64_t need = sc_estimate_bytes(total);
     if (need > j->task->reserved &&
         scd_budget_reserve(srv, j->task, need - j->task->reserved) != 0) {
-      char a[32], b[32];
+      char a[32], b[32], left[32];
       fmt_bytes(a, sizeof a, need);
+      fmt_bytes(left, sizeof left,
+                j->task->reserved + srv->cfg.memory_budget - srv->budget_used);
       fmt_bytes(b, sizeof b, srv->cfg.memory_budget);
       fail_upload(c, j, SCP_WIRE_NO_MEMORY,
-                  "memory budget exhausted at %llu points: the job needs "
-                  "about %s of %s",
-                  (ull)total, a, b);
+                  "memory budget exhausted at %llu points: the job would "
+                  "need about %s; %s of the %s budget is left for it",
+                  (ull)total, a, left, b);
       return;
     }
   }

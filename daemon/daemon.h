@@ -80,6 +80,7 @@ typedef struct scd_server {
   uv_signal_t sigterm, sigint;
   uv_timer_t tick;         /* once a second: timeouts */
   uv_timer_t grace;        /* ends the grace period of a shutdown */
+  uv_timer_t trim;         /* gives memory back once idle */
   scd_pool_t *pool;
 
   scd_conn_t *conns;       /* every open connection */

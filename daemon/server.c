@@ -59,19 +59,24 @@ void scd_budget_set(scd_server_t *srv, scd_task_t *t, uint64_t bytes) {
 }
 
 /* glibc keeps freed memory in per-thread arenas; hand it back to the system
- * when the daemon goes idle, so that its size returns to where it was. */
-static void trim_memory(void) {
+ * when the daemon has been idle for a moment, so that its size returns to
+ * where it was after a burst. The delay keeps the trim (a walk over every
+ * arena) off the path of a client that sends one job after another. */
+static void on_trim(uv_timer_t *h) {
+  scd_server_t *srv = h->data;
+  if (srv->tasks_live == 0) {
 #ifdef __GLIBC__
-  malloc_trim(0);
+    malloc_trim(0);
 #endif
+  }
 }
 
 void scd_server_free_task(scd_server_t *srv, scd_task_t *t) {
   scd_budget_set(srv, t, 0);
   scd_task_free(t);
   srv->tasks_live--;
-  if (srv->tasks_live == 0)
-    trim_memory();
+  if (srv->tasks_live == 0 && !uv_is_closing((uv_handle_t *)&srv->trim))
+    uv_timer_start(&srv->trim, on_trim, 250, 0);
 }
 
 void scd_server_stats(scd_server_t *srv, scp_buf_t *b, uint32_t tag) {
@@ -127,6 +132,7 @@ void scd_server_maybe_finish(scd_server_t *srv) {
   close_handle((uv_handle_t *)&srv->sigint);
   close_handle((uv_handle_t *)&srv->tick);
   close_handle((uv_handle_t *)&srv->grace);
+  close_handle((uv_handle_t *)&srv->trim);
   scd_pool_close(srv->pool);
 }
 
@@ -282,6 +288,8 @@ int scd_server_run(const scd_config_t *cfg) {
   uv_timer_start(&srv->tick, on_tick, 1000, 1000);
   uv_timer_init(srv->loop, &srv->grace);
   srv->grace.data = srv;
+  uv_timer_init(srv->loop, &srv->trim);
+  srv->trim.data = srv;
 
   char budget[32];
   snprintf(budget, sizeof budget, "%.1f MiB",

@@ -219,20 +219,38 @@ int scdt_log_contains(const scdt_daemon_t *d, const char *text) {
   return log_scan(d, text, 0) > 0;
 }
 
+int scdt_log_wait(const scdt_daemon_t *d, const char *text, int timeout_ms) {
+  uint64_t deadline = scdt_now_ms() + (uint64_t)timeout_ms;
+  while (!scdt_log_contains(d, text)) {
+    if (scdt_now_ms() >= deadline)
+      return 0;
+    scdt_sleep_ms(20);
+  }
+  return 1;
+}
+
 int scdt_log_count(const scdt_daemon_t *d, const char *text) {
   return log_scan(d, text, 1);
 }
 
-double *scdt_sample(int surface, size_t n, uint64_t seed) {
+static double *sample(int surface, int density, size_t n, uint64_t seed) {
   double *xyz = malloc(n * 3 * sizeof(double));
   if (!xyz)
     return NULL;
-  if (sc_sample_surface((sc_surface_t)surface, SC_DENSITY_UNIFORM, n, seed,
-                        xyz) != SC_TS_OK) {
+  if (sc_sample_surface((sc_surface_t)surface, density, n, seed, xyz) !=
+      SC_TS_OK) {
     free(xyz);
     return NULL;
   }
   return xyz;
+}
+
+double *scdt_sample(int surface, size_t n, uint64_t seed) {
+  return sample(surface, SC_DENSITY_UNIFORM, n, seed);
+}
+
+double *scdt_sample_random(int surface, size_t n, uint64_t seed) {
+  return sample(surface, SC_DENSITY_UNIFORM_RANDOM, n, seed);
 }
 
 int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {

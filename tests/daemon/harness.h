@@ -88,11 +88,17 @@ int scdt_daemon_wait(scdt_daemon_t *d, int timeout_ms);
 int scdt_daemon_stop(scdt_daemon_t *d);
 /* 1 when the log contains the text. */
 int scdt_log_contains(const scdt_daemon_t *d, const char *text);
+/* Waits up to timeout_ms for the text to appear in the log: 1 when it
+ * did. */
+int scdt_log_wait(const scdt_daemon_t *d, const char *text, int timeout_ms);
 /* Counts lines of the log containing the text. */
 int scdt_log_count(const scdt_daemon_t *d, const char *text);
 
 /* Well-spaced samples of a test surface (sc_surface_t), malloc'd. */
 double *scdt_sample(int surface, size_t n, uint64_t seed);
+/* Independent uniform samples: much quicker to make, for jobs that are
+ * meant to be stopped rather than checked. */
+double *scdt_sample_random(int surface, size_t n, uint64_t seed);
 /* 1 when job j came back as a correct mesh of `surface` over its own points
  * (closed manifold, oriented, right components and genus); otherwise 0
  * with the reason in why. */

@@ -84,7 +84,7 @@ static void cancel_while_running(void) {
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, 1u << 20, &c) == 0, "connect");
   size_t n = 40000;
-  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 4);
+  double *xyz = scdt_sample_random(SC_SURF_SPHERE, n, 4);
   scdt_job_t j;
   scdt_job_init(&j, 8, xyz, n);
   scdt_job_t *pj = &j;
@@ -135,7 +135,7 @@ static void disconnect_while_running(void) {
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, 1u << 20, &c) == 0, "connect");
   size_t n = 40000;
-  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 6);
+  double *xyz = scdt_sample_random(SC_SURF_SPHERE, n, 6);
   scdt_job_t j;
   scdt_job_init(&j, 9, xyz, n);
   CHECK(scdt_job_send(c, &j) == 0, "send");

@@ -29,7 +29,7 @@ static void running_and_queued(void) {
   scdt_daemon_t d;
   const char *args[] = {"--workers", "1", "--grace", "60", NULL};
   REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
-  size_t big = 30000;
+  size_t big = 15000;
   double *xyz = scdt_sample(SC_SURF_SPHERE, big, 1);
   double *small = scdt_sample(SC_SURF_TORUS, 3000, 2);
   scdt_conn_t *a, *b;
@@ -91,7 +91,7 @@ static void grace_over(void) {
   const char *args[] = {"--workers", "1", "--grace", "0.2", NULL};
   REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
   size_t big = 60000;
-  double *xyz = scdt_sample(SC_SURF_SPHERE, big, 3);
+  double *xyz = scdt_sample_random(SC_SURF_SPHERE, big, 3);
   scdt_conn_t *a;
   REQUIRE(scdt_open(d.sock, 1u << 20, &a) == 0, "a");
   scdt_job_t run;

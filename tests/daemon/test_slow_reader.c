@@ -103,7 +103,7 @@ static void small(void) {
   /* The replies are about 40 times the requests: with the queue bounded,
    * the daemon must have stopped reading long before all of them. */
   CHECK(n > 0, "nothing sent");
-  CHECK(scdt_log_contains(&d, "not reading until the client catches up"),
+  CHECK(scdt_log_wait(&d, "not reading until the client catches up", T_MS),
         "no log line for the throttled connection");
   /* The job finishes computing, but its mesh waits for room. */
   CHECK_EQ(scdt_stat_wait(d.sock, "workers_busy", 0, T_MS), 0);
