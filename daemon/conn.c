@@ -54,8 +54,10 @@ static int live(const scd_conn_t *c) {
 
 static void set_reading(scd_conn_t *c, int on);
 
-/* Counts an encoder's result; a failure to encode a reply we built
- * ourselves means we are out of memory, and the connection cannot go on. */
+/* Counts an encoder's result. A failure to encode a reply we built
+ * ourselves means we are out of memory, and the connection cannot go on;
+ * it is closed by the next flush(), not here, because the caller may still
+ * hold one of its jobs. */
 static int sent(scd_conn_t *c, int rc) {
   if (rc == 0) {
     c->srv->n.frames_out_total++;
@@ -63,7 +65,7 @@ static int sent(scd_conn_t *c, int rc) {
   }
   scd_error("conn %llu: cannot encode a frame: %s", (ull)c->id,
             scp_strerror(rc));
-  scd_conn_close_now(c, "out of memory for output");
+  c->broken = 1;
   return rc;
 }
 
@@ -352,8 +354,10 @@ static void conn_fatal(scd_conn_t *c, uint32_t code, uint32_t job_id,
   snprintf(c->close_reason, sizeof c->close_reason, "%s: %s",
            scp_wire_name(code), e.message);
   end_all_jobs(c, c->close_reason);
-  if (sent(c, scp_enc_error(&c->out, &e)) != 0)
+  if (sent(c, scp_enc_error(&c->out, &e)) != 0) {
+    flush(c);
     return;
+  }
   c->state = SCD_CONN_CLOSING;
   c->deadline_ns = uv_hrtime() + c->srv->cfg.close_ms * 1000000u;
   set_reading(c, 0);
@@ -448,6 +452,10 @@ static void on_write(uv_write_t *req, int status) {
 static void flush(scd_conn_t *c) {
   if (c->state == SCD_CONN_CLOSED)
     return;
+  if (c->broken) {
+    scd_conn_close_now(c, "out of memory for output");
+    return;
+  }
   if (queued(c) > c->srv->cfg.out_hard) {
     c->srv->n.slow_readers_closed_total++;
     scd_warn("conn %llu: %zu bytes of output queued, over the hard cap of %zu",
@@ -716,6 +724,12 @@ static void refuse_job(scd_conn_t *c, uint32_t id, uint32_t code,
   log_job(c, j, "refused", detail);
 }
 
+static uint64_t budget_left(const scd_server_t *srv) {
+  return srv->budget_used < srv->cfg.memory_budget
+             ? srv->cfg.memory_budget - srv->budget_used
+             : 0;
+}
+
 static void fmt_bytes(char *buf, size_t len, uint64_t b) {
   snprintf(buf, len, "%.1f MiB", (double)b / (1024.0 * 1024.0));
 }
@@ -783,7 +797,7 @@ static void on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
   if (scd_budget_reserve(srv, t, need) != 0) {
     char a[32], b[32], d[32];
     fmt_bytes(a, sizeof a, need);
-    fmt_bytes(b, sizeof b, srv->cfg.memory_budget - srv->budget_used);
+    fmt_bytes(b, sizeof b, budget_left(srv));
     fmt_bytes(d, sizeof d, srv->cfg.memory_budget);
     scd_server_free_task(srv, t);
     refuse_job(c, id, SCP_WIRE_BUSY,
@@ -959,7 +973,7 @@ static void on_points(scd_conn_t *c, const scp_frame_t *f) {
       char a[32], b[32], left[32];
       fmt_bytes(a, sizeof a, need);
       fmt_bytes(left, sizeof left,
-                j->task->reserved + srv->cfg.memory_budget - srv->budget_used);
+                j->task->reserved + budget_left(srv));
       fmt_bytes(b, sizeof b, srv->cfg.memory_budget);
       fail_upload(c, j, SCP_WIRE_NO_MEMORY,
                   "memory budget exhausted at %llu points: the job would "

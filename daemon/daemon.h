@@ -141,6 +141,7 @@ struct scd_conn {
   int state;
   int counted;             /* counts against --max-connections */
   int reading;             /* uv_read_start() in force */
+  int broken;              /* out of memory for output: close at flush */
   scp_decoder_t *dec;
 
   /* Output: frames are appended to out; wbuf is the one being written. */

@@ -45,7 +45,10 @@ void scd_config_init(scd_config_t *cfg) {
 }
 
 int scd_budget_reserve(scd_server_t *srv, scd_task_t *t, uint64_t bytes) {
-  if (bytes > srv->cfg.memory_budget - srv->budget_used)
+  /* Meshes are accounted at their real size, which may in principle go
+   * over the budget; nothing more is admitted then. */
+  if (srv->budget_used > srv->cfg.memory_budget ||
+      bytes > srv->cfg.memory_budget - srv->budget_used)
     return -1;
   srv->budget_used += bytes;
   t->reserved += bytes;
