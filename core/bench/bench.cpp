@@ -125,13 +125,19 @@ void check_mesh(size_t n, const double *xyz, const uint32_t *tri, size_t nt,
   sc_meshcheck_free(&c);
 }
 
+// The points as CGAL wants them; the copy is part of what a CGAL user pays.
+std::vector<Point> to_points(const double *xyz, size_t n) {
+  std::vector<Point> pts;
+  pts.reserve(n);
+  for (size_t i = 0; i < n; ++i)
+    pts.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  return pts;
+}
+
 Result run_cgal_delaunay(const double *xyz, size_t n) {
   return in_child([&](Result &r) {
     double t0 = now();
-    std::vector<Point> pts;
-    pts.reserve(n);
-    for (size_t i = 0; i < n; ++i)
-      pts.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    std::vector<Point> pts = to_points(xyz, n);
     CGAL::Delaunay_triangulation_3<K> dt(pts.begin(), pts.end());
     r.seconds = now() - t0;
     r.ok = dt.dimension() == 3;
@@ -160,10 +166,7 @@ Result run_shortcrust(const double *xyz, size_t n, int threads) {
 Result run_advancing_front(const double *xyz, size_t n) {
   return in_child([&](Result &r) {
     double t0 = now();
-    std::vector<Point> pts;
-    pts.reserve(n);
-    for (size_t i = 0; i < n; ++i)
-      pts.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    std::vector<Point> pts = to_points(xyz, n);
     std::vector<std::array<std::size_t, 3>> facets;
     CGAL::advancing_front_surface_reconstruction(pts.begin(), pts.end(),
                                                  std::back_inserter(facets));
