@@ -283,6 +283,7 @@ static void invalid_requests(void) {
   CHECK(c->got_error && c->last_error.code == SCP_WIRE_STATE,
         "want ERROR STATE, got %s", scp_wire_name(c->last_error.code));
   CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &j, why, sizeof why), "%s", why);
+  scdt_job_reset(&j);
 
   /* Bad points: a NaN, and points all in one plane. */
   double *bad = malloc(3000 * 3 * sizeof(double));
