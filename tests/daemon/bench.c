@@ -1,0 +1,369 @@
+/*
+ * shortcrustd-bench: what the daemon costs and what it gives.
+ *
+ *   1. Latency: one job of --points points (default 100000) through the
+ *      daemon, from the first byte sent to the last byte of the mesh,
+ *      against sc_reconstruct() on the same points in this process.
+ *   2. Throughput: --jobs jobs of --job-points points over 4 connections at
+ *      once, with 1 .. --workers-max workers.
+ *   3. Memory: the daemon's resident size idle, at the peak of a burst,
+ *      and once the burst is over.
+ *
+ * Every figure is the median of --repeat runs. Meshes are checked (closed
+ * sphere) so that a fast wrong answer does not count.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "harness.h"
+#include "shortcrust.h"
+#include "testsupport.h"
+
+#define T_MS 600000
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n) {
+  qsort(v, (size_t)n, sizeof *v, cmp_double);
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static double seconds(void) { return (double)scdt_now_ms() / 1e3; }
+
+/* Resident size of a process, bytes; 0 when unknown. */
+static uint64_t rss_of(pid_t pid) {
+  char path[64], line[256];
+  snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+  FILE *f = fopen(path, "r");
+  if (!f)
+    return 0;
+  uint64_t kb = 0;
+  while (fgets(line, sizeof line, f))
+    if (sscanf(line, "VmRSS: %llu kB", (unsigned long long *)&kb) == 1)
+      break;
+  fclose(f);
+  return kb * 1024;
+}
+
+static int start(scdt_daemon_t *d, unsigned workers) {
+  char w[16];
+  snprintf(w, sizeof w, "%u", workers);
+  const char *args[] = {"--workers", w, "--log-level", "warn", NULL};
+  return scdt_daemon_start(d, args);
+}
+
+/* One job through a connection; seconds, or -1. */
+static double one_job(const char *sock, const double *xyz, size_t n,
+                      uint64_t *ntri) {
+  scdt_conn_t *c;
+  if (scdt_open(sock, 1u << 20, &c) != 0)
+    return -1;
+  scdt_job_t j;
+  scdt_job_init(&j, 1, xyz, n);
+  scdt_job_t *pj = &j;
+  char why[512] = "";
+  double t0 = seconds();
+  int rc = scdt_job_send(c, &j);
+  if (rc == 0)
+    rc = scdt_collect(c, &pj, 1, T_MS, why, sizeof why);
+  double t = seconds() - t0;
+  if (rc != 0 || !j.done) {
+    fprintf(stderr, "job failed: %s %s\n", why, j.error_msg);
+    t = -1;
+  } else if (!scdt_mesh_ok(SC_SURF_SPHERE, &j, why, sizeof why)) {
+    fprintf(stderr, "wrong mesh: %s\n", why);
+    t = -1;
+  }
+  *ntri = j.ntri;
+  scdt_job_reset(&j);
+  scdt_close(c);
+  return t;
+}
+
+static void latency(size_t n, int repeat) {
+  printf("latency: one job of %zu points\n", n);
+  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 1);
+  double *direct = calloc((size_t)repeat, sizeof *direct);
+  double *daemon = calloc((size_t)repeat, sizeof *daemon);
+  uint64_t direct_tri = 0, daemon_tri = 0;
+  sc_params_t p;
+  sc_params_init(&p);
+  for (int r = 0; r < repeat; r++) {
+    sc_mesh_t *m = NULL;
+    double t0 = seconds();
+    int rc = sc_reconstruct(xyz, n, &p, &m, NULL, 0);
+    direct[r] = seconds() - t0;
+    if (rc == 0)
+      direct_tri = m->triangle_count;
+    sc_mesh_free(m);
+  }
+  scdt_daemon_t d;
+  if (start(&d, 1) != 0) {
+    fprintf(stderr, "daemon did not start\n");
+    exit(1);
+  }
+  for (int r = 0; r < repeat; r++)
+    daemon[r] = one_job(d.sock, xyz, n, &daemon_tri);
+  scdt_daemon_stop(&d);
+  double a = median(direct, repeat), b = median(daemon, repeat);
+  printf("  direct sc_reconstruct  %8.3f s  (%llu triangles)\n", a,
+         (unsigned long long)direct_tri);
+  printf("  through the daemon     %8.3f s  (%llu triangles, upload and "
+         "download included)\n",
+         b, (unsigned long long)daemon_tri);
+  printf("  ratio daemon/direct    %8.3f\n", b / a);
+  free(direct);
+  free(daemon);
+  free(xyz);
+}
+
+typedef struct burst {
+  const char *sock;
+  double **xyz;
+  size_t n;
+  int first, count;  /* jobs of this connection */
+  atomic_int *failed;
+  double end;        /* when its last job ended */
+} burst_t;
+
+static void *burst_client(void *arg) {
+  burst_t *b = arg;
+  scdt_conn_t *c;
+  if (scdt_open(b->sock, 1u << 20, &c) != 0) {
+    atomic_fetch_add(b->failed, b->count);
+    return NULL;
+  }
+  scdt_job_t *j = calloc((size_t)b->count, sizeof *j);
+  scdt_job_t **pj = calloc((size_t)b->count, sizeof *pj);
+  for (int k = 0; k < b->count; k++) {
+    scdt_job_init(&j[k], (uint32_t)k + 1, b->xyz[b->first + k], b->n);
+    pj[k] = &j[k];
+    if (scdt_job_send(c, &j[k]) != 0)
+      atomic_fetch_add(b->failed, 1);
+  }
+  char why[512] = "";
+  if (scdt_collect(c, pj, (size_t)b->count, T_MS, why, sizeof why) != 0)
+    fprintf(stderr, "burst: %s\n", why);
+  b->end = seconds();
+  /* Checked after the clock stopped: the checks share the machine with the
+   * daemon. */
+  for (int k = 0; k < b->count; k++) {
+    if (!j[k].done || !scdt_mesh_ok(SC_SURF_SPHERE, &j[k], why, sizeof why))
+      atomic_fetch_add(b->failed, 1);
+    scdt_job_reset(&j[k]);
+  }
+  free(j);
+  free(pj);
+  scdt_close(c);
+  return NULL;
+}
+
+/* All jobs at once over 4 connections; seconds. */
+static double burst(const char *sock, double **xyz, size_t n, int jobs,
+                    int *failed_out) {
+  enum { NC = 4 };
+  pthread_t th[NC];
+  burst_t b[NC];
+  atomic_int failed;
+  atomic_init(&failed, 0);
+  double t0 = seconds();
+  int at = 0;
+  for (int i = 0; i < NC; i++) {
+    int count = jobs / NC + (i < jobs % NC);
+    b[i] = (burst_t){sock, xyz, n, at, count, &failed, 0};
+    at += count;
+    pthread_create(&th[i], NULL, burst_client, &b[i]);
+  }
+  double end = t0;
+  for (int i = 0; i < NC; i++) {
+    pthread_join(th[i], NULL);
+    if (b[i].end > end)
+      end = b[i].end;
+  }
+  *failed_out = atomic_load(&failed);
+  return end - t0;
+}
+
+/* The same jobs in this process, on `threads` threads calling
+ * sc_reconstruct(): how far the machine itself scales. */
+typedef struct direct {
+  double **xyz;
+  size_t n;
+  int jobs;
+  atomic_int next;
+} direct_t;
+
+static void *direct_worker(void *arg) {
+  direct_t *d = arg;
+  sc_params_t p;
+  sc_params_init(&p);
+  for (;;) {
+    int k = atomic_fetch_add(&d->next, 1);
+    if (k >= d->jobs)
+      return NULL;
+    sc_mesh_t *m = NULL;
+    sc_reconstruct(d->xyz[k], d->n, &p, &m, NULL, 0);
+    sc_mesh_free(m);
+  }
+}
+
+static double direct_burst(double **xyz, size_t n, int jobs,
+                           unsigned threads) {
+  direct_t d = {.xyz = xyz, .n = n, .jobs = jobs};
+  atomic_init(&d.next, 0);
+  pthread_t *th = calloc(threads, sizeof *th);
+  double t0 = seconds();
+  for (unsigned i = 0; i < threads; i++)
+    pthread_create(&th[i], NULL, direct_worker, &d);
+  for (unsigned i = 0; i < threads; i++)
+    pthread_join(th[i], NULL);
+  free(th);
+  return seconds() - t0;
+}
+
+typedef struct sampler {
+  pid_t pid;
+  atomic_int stop;
+  uint64_t peak;
+} sampler_t;
+
+static void *sample_rss(void *arg) {
+  sampler_t *s = arg;
+  while (!atomic_load(&s->stop)) {
+    uint64_t r = rss_of(s->pid);
+    if (r > s->peak)
+      s->peak = r;
+    scdt_sleep_ms(5);
+  }
+  return NULL;
+}
+
+static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
+  printf("throughput: %d jobs of %zu points over 4 connections\n", jobs, n);
+  double **xyz = calloc((size_t)jobs, sizeof *xyz);
+  for (int k = 0; k < jobs; k++)
+    xyz[k] = scdt_sample(SC_SURF_SPHERE, n, (uint64_t)k + 10);
+  double base = 0, direct_base = 0;
+  double *t = calloc((size_t)repeat, sizeof *t);
+  for (unsigned w = 1; w <= wmax; w++) {
+    for (int r = 0; r < repeat; r++)
+      t[r] = direct_burst(xyz, n, jobs, w);
+    double dm = median(t, repeat);
+    if (w == 1)
+      direct_base = dm;
+    scdt_daemon_t d;
+    if (start(&d, w) != 0) {
+      fprintf(stderr, "daemon did not start\n");
+      exit(1);
+    }
+    uint64_t idle = rss_of(d.pid);
+    sampler_t s = {.pid = d.pid, .peak = idle};
+    atomic_init(&s.stop, 0);
+    pthread_t st;
+    pthread_create(&st, NULL, sample_rss, &s);
+    int failed = 0;
+    for (int r = 0; r < repeat; r++) {
+      int f = 0;
+      t[r] = burst(d.sock, xyz, n, jobs, &f);
+      failed += f;
+    }
+    atomic_store(&s.stop, 1);
+    pthread_join(st, NULL);
+    scdt_stat_wait(d.sock, "jobs_active", 0, T_MS);
+    scdt_sleep_ms(1000);
+    uint64_t after = rss_of(d.pid);
+    uint64_t held = scdt_stat_fresh(d.sock, "memory_jobs_bytes");
+    scdt_daemon_stop(&d);
+    double m = median(t, repeat);
+    if (w == 1)
+      base = m;
+    printf("  %u worker%s  %7.3f s  %6.2f jobs/s  speed-up %.2f%s   "
+           "(in-process sc_reconstruct on %u thread%s: %.3f s, speed-up "
+           "%.2f; daemon/direct %.3f)\n",
+           w, w == 1 ? " " : "s", m, jobs / m, base / m,
+           failed ? "  (FAILED JOBS)" : "", w, w == 1 ? "" : "s", dm,
+           direct_base / dm, m / dm);
+    printf("             memory: idle %.1f MiB, peak %.1f MiB, after the "
+           "burst %.1f MiB (ratio after/idle %.2f); job memory held after: "
+           "%llu bytes\n",
+           idle / 1048576.0, s.peak / 1048576.0, after / 1048576.0,
+           idle ? (double)after / (double)idle : 0.0,
+           (unsigned long long)held);
+  }
+  for (int k = 0; k < jobs; k++)
+    free(xyz[k]);
+  free(xyz);
+  free(t);
+}
+
+static void usage(void) {
+  printf("Usage: shortcrustd-bench [--daemon PATH] [--points N] [--jobs N] "
+         "[--job-points N]\n"
+         "                         [--workers-max W] [--repeat R]\n"
+         "Defaults: the shortcrustd next to this program, 100000 points, 16 "
+         "jobs of\n20000 points, W = number of cores, R = 3.\n");
+}
+
+int main(int argc, char **argv) {
+  static char self_dir[4096];
+  const char *daemon = NULL;
+  size_t points = 100000, job_points = 20000;
+  int jobs = 16, repeat = 3;
+  unsigned wmax = (unsigned)sysconf(_SC_NPROCESSORS_ONLN);
+  for (int i = 1; i < argc; i++) {
+    const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+    if (strcmp(a, "--help") == 0) {
+      usage();
+      return 0;
+    }
+    if (!v) {
+      usage();
+      return 2;
+    }
+    if (strcmp(a, "--daemon") == 0)
+      daemon = v;
+    else if (strcmp(a, "--points") == 0)
+      points = (size_t)atol(v);
+    else if (strcmp(a, "--jobs") == 0)
+      jobs = atoi(v);
+    else if (strcmp(a, "--job-points") == 0)
+      job_points = (size_t)atol(v);
+    else if (strcmp(a, "--workers-max") == 0)
+      wmax = (unsigned)atoi(v);
+    else if (strcmp(a, "--repeat") == 0)
+      repeat = atoi(v);
+    else {
+      usage();
+      return 2;
+    }
+    i++;
+  }
+  if (!daemon) {
+    ssize_t len = readlink("/proc/self/exe", self_dir, sizeof self_dir - 32);
+    if (len <= 0)
+      return 2;
+    self_dir[len] = '\0';
+    char *slash = strrchr(self_dir, '/');
+    strcpy(slash ? slash + 1 : self_dir, "shortcrustd");
+    daemon = self_dir;
+  }
+  if (points < 4 || job_points < 4 || jobs < 1 || repeat < 1 || wmax < 1) {
+    usage();
+    return 2;
+  }
+  char *fake[] = {argv[0], (char *)daemon, NULL};
+  scdt_init(2, fake);
+  latency(points, repeat);
+  throughput(job_points, jobs, wmax, repeat);
+  return scdt_finish();
+}
