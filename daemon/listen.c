@@ -87,6 +87,12 @@ static int take_lock(scd_server_t *srv) {
    * unlinked, the lock protects nothing, so check and try again. */
   for (int attempt = 0; attempt < 10; attempt++) {
     int fd = open(srv->lock_path, O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+    if (fd < 0 && errno == ENOENT) {
+      scd_error("the directory of %s does not exist; create it, or choose "
+                "another path with --socket",
+                srv->socket_path);
+      return -1;
+    }
     if (fd < 0) {
       scd_error("cannot open %s: %s", srv->lock_path, strerror(errno));
       return -1;
