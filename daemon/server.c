@@ -82,6 +82,35 @@ void scd_server_free_task(scd_server_t *srv, scd_task_t *t) {
     uv_timer_start(&srv->trim, on_trim, 250, 0);
 }
 
+/*
+ * STATS, all u64 (PROTOCOL.md 6.13 leaves the names to the server):
+ *
+ *   connections                 connections open now (refused ones aside)
+ *   connections_total           connections accepted, refused ones included
+ *   connections_refused_total   refused for --max-connections
+ *   jobs_active                 jobs holding memory: queued, running, or
+ *                               sending their mesh
+ *   jobs_accepted_total         JOB_BEGINs answered with ACCEPTED
+ *   jobs_refused_total          JOB_BEGINs answered with JOB_ERROR
+ *   jobs_done_total             jobs that ended with JOB_DONE
+ *   jobs_failed_total           accepted jobs that ended with JOB_ERROR
+ *                               other than CANCELLED
+ *   jobs_cancelled_total        jobs stopped by CANCEL or by their client
+ *                               going away
+ *   points_in_total             points received
+ *   triangles_out_total         triangles of the meshes delivered
+ *   bytes_in_total, bytes_out_total, frames_in_total, frames_out_total
+ *   protocol_errors_total       fatal ERRORs sent, SHUTDOWN aside
+ *   slow_readers_closed_total   connections closed for not reading
+ *   queue_depth                 jobs waiting for a worker
+ *   workers, workers_busy       the pool, and the workers running a job
+ *   memory_jobs_bytes           memory held by jobs, as estimated for
+ *                               admission (meshes at their real size)
+ *   memory_budget_bytes         --memory-budget
+ *   output_queued_bytes         output waiting to be written, all
+ *                               connections together
+ *   shutting_down               1 once SIGTERM or SIGINT came
+ */
 void scd_server_stats(scd_server_t *srv, scp_buf_t *b, uint32_t tag) {
   scd_pool_stats_t ps;
   scd_pool_get_stats(srv->pool, &ps);
