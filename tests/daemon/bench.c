@@ -16,6 +16,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <pthread.h>
+#include <sys/resource.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,6 +54,34 @@ static uint64_t rss_of(pid_t pid) {
       break;
   fclose(f);
   return kb * 1024;
+}
+
+/* CPU seconds a process has used (user and system); 0 when unknown. */
+static double cpu_of(pid_t pid) {
+  char path[64];
+  snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+  FILE *f = fopen(path, "r");
+  if (!f)
+    return 0;
+  char buf[2048];
+  size_t n = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[n] = '\0';
+  /* Fields 14 and 15, counted after the command name in parentheses. */
+  char *p = strrchr(buf, ')');
+  unsigned long long ut = 0, st = 0;
+  if (!p || sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu "
+                          "%llu",
+                   &ut, &st) != 2)
+    return 0;
+  return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
+}
+
+static double cpu_self(void) {
+  struct rusage ru;
+  getrusage(RUSAGE_SELF, &ru);
+  return (double)ru.ru_utime.tv_sec + ru.ru_utime.tv_usec / 1e6 +
+         (double)ru.ru_stime.tv_sec + ru.ru_stime.tv_usec / 1e6;
 }
 
 static int start(scdt_daemon_t *d, unsigned workers) {
@@ -256,8 +285,10 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
   double base = 0, direct_base = 0;
   double *t = calloc((size_t)repeat, sizeof *t);
   for (unsigned w = 1; w <= wmax; w++) {
+    double c0 = cpu_self();
     for (int r = 0; r < repeat; r++)
       t[r] = direct_burst(xyz, n, jobs, w);
+    double direct_cpu = (cpu_self() - c0) / repeat;
     double dm = median(t, repeat);
     if (w == 1)
       direct_base = dm;
@@ -272,11 +303,13 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
     pthread_t st;
     pthread_create(&st, NULL, sample_rss, &s);
     int failed = 0;
+    double c1 = cpu_of(d.pid);
     for (int r = 0; r < repeat; r++) {
       int f = 0;
       t[r] = burst(d.sock, xyz, n, jobs, &f);
       failed += f;
     }
+    double daemon_cpu = (cpu_of(d.pid) - c1) / repeat;
     atomic_store(&s.stop, 1);
     pthread_join(st, NULL);
     scdt_stat_wait(d.sock, "jobs_active", 0, T_MS);
@@ -293,6 +326,9 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
            w, w == 1 ? " " : "s", m, jobs / m, base / m,
            failed ? "  (FAILED JOBS)" : "", w, w == 1 ? "" : "s", dm,
            direct_base / dm, m / dm);
+    printf("             CPU per burst: daemon %.3f s, in-process %.3f s "
+           "(ratio %.3f)\n",
+           daemon_cpu, direct_cpu, direct_cpu > 0 ? daemon_cpu / direct_cpu : 0);
     printf("             memory: idle %.1f MiB, peak %.1f MiB, after the "
            "burst %.1f MiB (ratio after/idle %.2f); job memory held after: "
            "%llu bytes\n",
