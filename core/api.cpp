@@ -56,6 +56,16 @@ extern "C" void sc_params_init(sc_params_t *p) {
   p->paper_pruning = 0;
   p->max_hole_edges = 100;
   p->threads = 1;
+  p->boundary_rho = sc::kDefaultRho;
+  p->boundary_alpha = sc::kDefaultAlpha;
+}
+
+extern "C" const char *sc_path_name(int path) {
+  static const char *const names[SC_PATH_COUNT_] = {
+      "shortcrust", "cocone", "boundary", "watertight", "watertight-fill"};
+  if (path < 0 || path >= SC_PATH_COUNT_)
+    return "?";
+  return names[path];
 }
 
 namespace sc {
@@ -90,6 +100,16 @@ int check_params(const sc_params_t *p, char *msg, size_t len) {
   if (p->max_hole_edges < 0 || p->max_hole_edges > 100000) {
     set_msg(msg, len, "max_hole_edges must be in [0, 100000], got %d",
             p->max_hole_edges);
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (!(p->boundary_rho >= 0 && p->boundary_rho <= 10)) {
+    set_msg(msg, len, "boundary_rho must be in (0, 10] or 0, got %g",
+            p->boundary_rho);
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (!(p->boundary_alpha >= 0 && p->boundary_alpha <= M_PI / 2)) {
+    set_msg(msg, len, "boundary_alpha must be in (0, pi/2] or 0, got %g",
+            p->boundary_alpha);
     return SC_EINVALID_ARGUMENT;
   }
   if (p->threads < 0) {

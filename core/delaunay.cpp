@@ -1,6 +1,8 @@
 // The stages that need the Delaunay triangulation: insertion (in chunks),
-// duplicates, poles, and the one pass over the Delaunay facets that selects
-// candidate triangles. The triangulation is freed before pruning starts.
+// duplicates, poles, boundary detection, and the one pass over the Delaunay
+// facets that selects candidate triangles. The triangulation is freed before
+// pruning starts, except in watertight mode, which labels its cells after
+// extraction to close the holes of the surface (close()).
 //
 // SPDX-License-Identifier: GPL-3.0-or-later
 
@@ -36,13 +38,41 @@ struct VertexData {
   uint32_t idx = 0; // index of the point in the input
   float best = -1;  // squared distance to the pole so far; inf on the hull
   double pole[3] = {0, 0, 0}; // pole direction, unit once computed
+  // Boundary detection (boundary, watertight and auto modes): squared
+  // distances to the farthest Voronoi vertex inside the cocone (r) and to
+  // the negative pole (h), and the kV* flags below.
+  float r2 = 0, h2 = 0;
+  uint8_t flags = 0;
   VertexData() = default;
   VertexData(uint32_t i) : idx(i) {}
 };
+enum : uint8_t {
+  kVRatio = 1,    // r <= rho h: the Voronoi cell is long and thin
+  kVDisagree = 2, // some cocone neighbour's pole is more than alpha away
+  kVInterior = 4, // an interior sample; the others are boundary samples
+};
 // Single precision is ample for where a Voronoi vertex lies relative to the
 // cocones and balls it is tested against, and keeps cells at 80 bytes.
+// Once the candidates are chosen the circumcentre is not needed any more,
+// and watertight mode reuses its bytes for the cell's label.
+struct CellLabel {
+  uint32_t local;      // scratch: the cell's place in a vertex's star
+  uint16_t vin, vout;  // surface triangles that put the cell inside, outside
+  uint8_t label;       // kUnlabelled, kInside, kOutside
+  uint8_t barrier;     // bit f: facet f is a surface triangle
+  uint8_t moved;       // relabelled once already: stays as it is now
+};
+enum : uint8_t { kUnlabelled = 0, kInside = 1, kOutside = 2 };
+// Boundary detection ignores, for the extent of a cell in the cocone, a
+// circumcentre farther than this from the cell's vertices, relative to the
+// cell's longest edge (squared).
+constexpr double kMaxCentreRatio2 = 8.0 * 8.0;
 struct CellData {
-  float cc[3]; // circumcentre (guarded), set by the poles stage
+  union {
+    float cc[3];  // circumcentre (guarded), set by the poles stage
+    CellLabel w;  // watertight mode, after the candidates
+  };
+  CellData() : cc{0, 0, 0} {}
 };
 typedef CGAL::Triangulation_vertex_base_with_info_3<VertexData, K> Vb;
 typedef CGAL::Triangulation_cell_base_with_info_3<
@@ -126,7 +156,9 @@ struct Criteria {
   double tan_phi;    // criterion 2: dual edge meets [-R tan phi, R tan phi]
   double sin_cocone; // cocone: |cos(y - s, p_s)| <= this
 
-  explicit Criteria(const sc_params_t &p) : mode(p.mode) {
+  explicit Criteria(const sc_params_t &p)
+      : mode(p.mode == SC_MODE_SHORTCRUST ? SC_MODE_SHORTCRUST
+                                          : SC_MODE_COCONE) {
     double r = p.r;
     double a = std::asin(std::min(1.0, r / (1 - r)));
     double b = std::asin(std::min(1.0, std::sqrt(3.0) * r / (1 - r)));
@@ -154,8 +186,10 @@ inline int cone_side(V3 dir, V3 pole_unit, double sin_cocone) {
 
 // The candidate test for triangle abc with indices idx. The dual Voronoi
 // edge runs from v1 to v2, or from v1 along direction v2 when `ray`.
-bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles, V3 v1,
-                  V3 v2, bool ray) {
+// interior says which vertices the cocone test is made at: all three except
+// in boundary mode, and at least one.
+bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles,
+                  const bool *interior, V3 v1, V3 v2, bool ray) {
   V3 n = cross(P[1] - P[0], P[2] - P[0]);
   double n2 = norm2(n);
   if (!(n2 > 0))
@@ -163,7 +197,11 @@ bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles, V3 v1,
   n = (1 / std::sqrt(n2)) * n;
 
   if (cr.mode == SC_MODE_COCONE) {
+    if (!interior[0] && !interior[1] && !interior[2])
+      return false;
     for (int k = 0; k < 3; ++k) {
+      if (!interior[k])
+        continue;
       const V3 &pole = poles[k];
       int s1 = cone_side(v1 - P[k], pole, cr.sin_cocone);
       if (s1 == 0)
@@ -245,7 +283,7 @@ public:
 
   void filter(const double *xyz, size_t n, const sc_params_t &params,
               Progress &progress, Filtered &out, sc_diag_t &diag,
-              double seconds[SC_STAGE_COUNT]) override {
+              double seconds[SC_STAGE_COUNT], bool keep) override {
     Stopwatch sw;
     progress.stage(SC_STAGE_DELAUNAY);
     resolve_duplicates(xyz, n, out.dups);
@@ -265,6 +303,8 @@ public:
 
     progress.stage(SC_STAGE_POLES);
     compute_poles(out.to_input.size(), progress, out.poles, diag);
+    if (detects_boundary(params.mode))
+      classify(params, progress, out.boundary, diag);
     seconds[SC_STAGE_POLES] += sw.lap();
 
     progress.stage(SC_STAGE_CANDIDATES);
@@ -272,8 +312,16 @@ public:
     diag.candidates = out.tris.size() / 3;
     // The triangulation is not needed any more: free it before pruning so
     // that the peak memory is the triangulation's alone.
-    dt_.clear();
+    if (!keep)
+      dt_.clear();
     seconds[SC_STAGE_CANDIDATES] += sw.lap();
+  }
+
+  bool close(std::vector<uint32_t> &tris, Progress &progress,
+             sc_diag_t &diag) override {
+    bool ok = label_and_close(tris, progress, diag);
+    dt_.clear();
+    return ok;
   }
 
 private:
@@ -395,11 +443,466 @@ private:
     }
   }
 
+  // Boundary detection, after Dey and Giesen ("Detecting undersampling in
+  // surface reconstruction", 2001). Where the surface is well sampled and
+  // has no boundary, the Voronoi cell of a sample is long and thin along
+  // the normal: everything of it inside the cocone is close to the sample
+  // (r, the farthest Voronoi vertex in the cocone) compared with the
+  // negative pole (h). At a boundary the cell opens up sideways, in the
+  // tangent plane, and r grows to the size of the gap beyond the boundary
+  // (to infinity on the convex hull). So:
+  //  - ratio test: r <= rho h;
+  //  - seeds: samples that pass it and whose pole agrees, within alpha
+  //    (unoriented), with the pole of every cocone neighbour (a sample q
+  //    sharing a Delaunay cell with s whose circumcentre lies in the cocone
+  //    of s: the Voronoi facet between s and q then meets that cocone; we
+  //    look only at Voronoi vertices, not at crossings of facet edges, which
+  //    is what one pass over the cells gives);
+  //  - growth: a neighbour that passes the ratio test and agrees with an
+  //    interior sample becomes interior.
+  // The rest are boundary samples.
+  void classify(const sc_params_t &params, Progress &progress,
+                std::vector<uint8_t> &boundary, sc_diag_t &diag) {
+    const double rho =
+        params.boundary_rho > 0 ? params.boundary_rho : kDefaultRho;
+    const double alpha =
+        params.boundary_alpha > 0 ? params.boundary_alpha : kDefaultAlpha;
+    const double sin_c = std::sin(params.cocone_theta);
+    const double cos_a = std::cos(alpha);
+    const float kInf = std::numeric_limits<float>::infinity();
+
+    // On the hull the Voronoi cell is unbounded, in the directions of the
+    // outward normals of the hull facets around the sample, and the pole is
+    // their average, so the ratio test sees nothing of that part of the
+    // cell. Where the surface goes on beyond a hull sample these normals
+    // stay close together; where it ends there (the rim of a hemisphere or
+    // of a scan, whose hull facets span the missing part) they fan out. So r
+    // is infinite when two of them are more than (pi/2 - theta) / 2 apart:
+    // the cell then opens up sideways, whatever the true normal is.
+    const double cos_fan = std::cos((M_PI / 2 - params.cocone_theta) / 2);
+    std::vector<std::pair<Vh, V3>> hull;
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
+      if (!dt_.is_infinite(c))
+        continue;
+      int inf = c->index(dt_.infinite_vertex());
+      V3 pts[3];
+      V3 nrm = hull_normal(c, inf, pts);
+      for (int k = 0; k < 3; ++k)
+        hull.emplace_back(c->vertex((inf + 1 + k) % 4), nrm);
+    }
+    std::sort(hull.begin(), hull.end(),
+              [](const std::pair<Vh, V3> &x, const std::pair<Vh, V3> &y) {
+                return &*x.first < &*y.first;
+              });
+    for (size_t i = 0; i < hull.size();) {
+      size_t j = i;
+      while (j < hull.size() && hull[j].first == hull[i].first)
+        ++j;
+      for (size_t a = i; a < j; ++a)
+        for (size_t b = a + 1; b < j; ++b)
+          if (dot(hull[a].second, hull[b].second) < cos_fan)
+            hull[i].first->info().r2 = kInf;
+      i = j;
+    }
+    hull = {};
+
+    size_t cells = dt_.number_of_cells(), k = 0;
+    V3 pole[4];
+    bool in_cone[4];
+    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
+         ++c, ++k) {
+      progress.tick(k, 2 * cells);
+      const float *ccc = c->info().cc;
+      V3 cc = {ccc[0], ccc[1], ccc[2]};
+      // A circumcentre much farther than the cell is long comes from a
+      // nearly degenerate cell (points close to a common circle, as on an
+      // exact cylinder or sphere), where it is ill-conditioned: rounding
+      // moves it anywhere along the circle's axis. It still counts for the
+      // pole and the negative pole, which lie along the axis anyway, but
+      // not for the extent of the cell in the cocone.
+      V3 P[4];
+      double longest2 = 0;
+      for (int j = 0; j < 4; ++j) {
+        P[j] = v3(c->vertex(j)->point());
+        for (int i = 0; i < j; ++i)
+          longest2 = std::max(longest2, norm2(P[i] - P[j]));
+      }
+      const bool trusted = norm2(cc - P[0]) <= kMaxCentreRatio2 * longest2;
+      for (int j = 0; j < 4; ++j) {
+        VertexData &d = c->vertex(j)->info();
+        pole[j] = {d.pole[0], d.pole[1], d.pole[2]};
+        V3 dv = cc - P[j];
+        double len2 = norm2(dv), dp = dot(dv, pole[j]);
+        if (dp < 0 && float(len2) > d.h2)
+          d.h2 = float(len2);
+        in_cone[j] = std::fabs(dp) <= sin_c * std::sqrt(len2);
+        if (in_cone[j] && trusted && float(len2) > d.r2)
+          d.r2 = float(len2);
+      }
+      for (int j = 0; j < 4; ++j) {
+        if (!in_cone[j])
+          continue;
+        for (int i = 0; i < 4; ++i)
+          if (i != j && std::fabs(dot(pole[i], pole[j])) < cos_a)
+            c->vertex(j)->info().flags |= kVDisagree;
+      }
+    }
+
+    std::vector<Vh> queue;
+    const float rho2 = float(rho * rho);
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v) {
+      VertexData &d = v->info();
+      d.flags &= uint8_t(~(kVRatio | kVInterior));
+      if (d.h2 > 0 && d.r2 <= rho2 * d.h2)
+        d.flags |= kVRatio;
+      if ((d.flags & kVRatio) && !(d.flags & kVDisagree)) {
+        d.flags |= kVInterior;
+        queue.push_back(v);
+      }
+    }
+    std::vector<Ch> inc;
+    const size_t m = dt_.number_of_vertices();
+    size_t grown = 0;
+    while (!queue.empty()) {
+      progress.tick(cells + (++grown) * cells / (m + 1), 2 * cells);
+      Vh v = queue.back();
+      queue.pop_back();
+      const VertexData &dv = v->info();
+      V3 pv = v3(v->point()), polev = {dv.pole[0], dv.pole[1], dv.pole[2]};
+      inc.clear();
+      dt_.finite_incident_cells(v, std::back_inserter(inc));
+      for (Ch c : inc) {
+        const float *ccc = c->info().cc;
+        V3 dir = V3{ccc[0], ccc[1], ccc[2]} - pv;
+        if (std::fabs(dot(dir, polev)) > sin_c * std::sqrt(norm2(dir)))
+          continue;
+        for (int j = 0; j < 4; ++j) {
+          Vh q = c->vertex(j);
+          VertexData &dq = q->info();
+          if (q == v || (dq.flags & kVInterior) || !(dq.flags & kVRatio))
+            continue;
+          V3 poleq = {dq.pole[0], dq.pole[1], dq.pole[2]};
+          if (std::fabs(dot(polev, poleq)) >= cos_a) {
+            dq.flags |= kVInterior;
+            queue.push_back(q);
+          }
+        }
+      }
+    }
+
+    boundary.assign(m, 0);
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v) {
+      if (!(v->info().flags & kVInterior)) {
+        boundary[v->info().idx] = 1;
+        ++diag.boundary_samples;
+      }
+    }
+  }
+
+  // Watertight mode: label every cell inside or outside across the
+  // oriented surface and take the boundary of the inside cells.
+  //  - Seeds: the cell behind an outward triangle is inside, the one in
+  //    front outside (a cell that several triangles touch takes the
+  //    majority); infinite cells are outside.
+  //  - A multi-source breadth-first search through the facets that are not
+  //    surface triangles labels the rest, so that the inside and outside
+  //    fronts meet in the middle of each hole.
+  //  - The boundary of the union of the inside cells is closed, but may
+  //    touch itself at an edge or a vertex. Around each vertex the cells of
+  //    each label must form one piece (joined across facets at the vertex);
+  //    that also rules out pinched edges. Where they do not, the smallest
+  //    offending piece moves to the other label, and the neighbours are
+  //    checked again.
+  bool label_and_close(std::vector<uint32_t> &tris, Progress &progress,
+                       sc_diag_t &diag) {
+    const size_t m = dt_.number_of_vertices();
+    std::vector<Vh> &vh = vh_;
+    vh.assign(m, Vh());
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v)
+      vh[v->info().idx] = v;
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
+      c->info().w = CellLabel{0, 0, 0, kUnlabelled, 0, 0};
+
+    // Open components may come out of extraction facing inward; the hull
+    // tells: a triangle on the hull must face the infinite cell. Flip a
+    // component whose hull triangles mostly face inward.
+    const size_t nt = tris.size() / 3;
+    std::vector<Ch> fc(nt);
+    std::vector<int8_t> fi(nt, -1);
+    std::vector<int8_t> hull_vote(nt, 0);
+    for (size_t t = 0; t < nt; ++t) {
+      progress.tick(t, 4 * nt + 1);
+      const uint32_t *v = &tris[3 * t];
+      int i, j, l;
+      Ch c;
+      if (!dt_.is_facet(vh[v[0]], vh[v[1]], vh[v[2]], c, i, j, l))
+        continue; // a hole-filling triangle: not a Delaunay facet
+      int f = 6 - i - j - l;
+      fc[t] = c;
+      fi[t] = int8_t(f);
+      Ch nb = c->neighbor(f);
+      bool c_front = in_front(v, c, f);
+      if (dt_.is_infinite(c))
+        hull_vote[t] = c_front ? 1 : -1;
+      else if (dt_.is_infinite(nb))
+        hull_vote[t] = c_front ? -1 : 1;
+    }
+    flip_inward_components(tris, hull_vote);
+
+    std::vector<Ch> queue;
+    for (size_t t = 0; t < nt; ++t) {
+      if (fi[t] < 0)
+        continue;
+      Ch c = fc[t], nb = c->neighbor(fi[t]);
+      bool c_front = in_front(&tris[3 * t], c, fi[t]);
+      vote(c, c_front ? kOutside : kInside);
+      vote(nb, c_front ? kInside : kOutside);
+      c->info().w.barrier |= uint8_t(1u << fi[t]);
+      nb->info().w.barrier |= uint8_t(1u << nb->index(c));
+    }
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
+      CellLabel &w = c->info().w;
+      if (dt_.is_infinite(c))
+        w.label = kOutside;
+      else if (w.vin || w.vout)
+        w.label = w.vin > w.vout ? kInside : kOutside;
+      if (w.label != kUnlabelled)
+        queue.push_back(c);
+    }
+    progress.tick(nt, 4 * nt + 1);
+    for (size_t head = 0; head < queue.size(); ++head) {
+      Ch c = queue[head];
+      const CellLabel w = c->info().w;
+      for (int f = 0; f < 4; ++f) {
+        if (w.barrier & (1u << f))
+          continue;
+        Ch nb = c->neighbor(f);
+        if (nb->info().w.label == kUnlabelled) {
+          nb->info().w.label = w.label;
+          queue.push_back(nb);
+        }
+      }
+    }
+    queue = std::vector<Ch>();
+    progress.tick(2 * nt, 4 * nt + 1);
+
+    // Repair. Only vertices with cells of both labels around them can be
+    // pinched.
+    std::vector<uint8_t> seen(m, 0);
+    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c)
+      for (int j = 0; j < 4; ++j)
+        seen[c->vertex(j)->info().idx] |= c->info().w.label;
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
+      if (dt_.is_infinite(c))
+        for (int j = 0; j < 4; ++j)
+          if (!dt_.is_infinite(c->vertex(j)))
+            seen[c->vertex(j)->info().idx] |= kOutside;
+    std::vector<Vh> work;
+    std::vector<uint8_t> queued(m, 0);
+    for (size_t i = 0; i < m; ++i)
+      if (seen[i] == (kInside | kOutside)) {
+        work.push_back(vh[i]);
+        queued[i] = 1;
+      }
+    const uint64_t budget = 64 * uint64_t(work.size()) + 10000;
+    uint64_t steps = 0;
+    bool gave_up = false;
+    // Rounds: a vertex at which no piece may move waits for the next round,
+    // which allows more moves per cell.
+    std::vector<Vh> unresolved, moved;
+    for (uint8_t max_moves : {2, 8, 32, 128}) {
+      for (Vh v : unresolved)
+        if (!queued[v->info().idx]) {
+          queued[v->info().idx] = 1;
+          work.push_back(v);
+        }
+      unresolved.clear();
+      while (!work.empty() && !gave_up) {
+        gave_up = ++steps > budget;
+        Vh v = work.back();
+        work.pop_back();
+        queued[v->info().idx] = 0;
+        moved.clear();
+        if (!repair_vertex(v, max_moves, moved, diag))
+          unresolved.push_back(v);
+        for (Vh u : moved)
+          if (!queued[u->info().idx]) {
+            queued[u->info().idx] = 1;
+            work.push_back(u);
+          }
+      }
+    }
+    progress.tick(3 * nt, 4 * nt + 1);
+    (void)gave_up;
+
+    std::vector<uint32_t> res;
+    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
+      if (c->info().w.label != kInside)
+        continue;
+      for (int f = 0; f < 4; ++f) {
+        if (c->neighbor(f)->info().w.label == kInside)
+          continue;
+        uint32_t t[3];
+        for (int j = 0; j < 3; ++j)
+          t[j] = c->vertex((f + 1 + j) % 4)->info().idx;
+        // Outward: the cell's own fourth vertex must be behind.
+        if (front(t, c->vertex(f)))
+          std::swap(t[1], t[2]);
+        res.insert(res.end(), t, t + 3);
+      }
+    }
+    if (res.empty())
+      return false;
+    tris.swap(res);
+    return true;
+  }
+
+  // Around vertex v, the cells of each label must form one piece, joined
+  // across the facets at v. If they do not, moves the smallest piece that
+  // may move (of a split label if possible; otherwise of the other label,
+  // which then takes the whole star and v leaves the surface), and appends
+  // the vertices of the moved cells to `touched`. A piece that holds an
+  // infinite cell, or a cell moved max_moves times already, stays, so the
+  // repair ends. Returns false when no piece could move.
+  bool repair_vertex(Vh v, uint8_t max_moves, std::vector<Vh> &touched,
+                     sc_diag_t &diag) {
+    std::vector<Ch> &inc = star_;
+    inc.clear();
+    dt_.incident_cells(v, std::back_inserter(inc));
+    const size_t k = inc.size();
+    for (size_t i = 0; i < k; ++i)
+      inc[i]->info().w.local = uint32_t(i);
+    std::vector<uint32_t> &parent = parent_;
+    parent.resize(k);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](uint32_t x) {
+      while (parent[x] != x)
+        x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    for (size_t i = 0; i < k; ++i) {
+      Ch c = inc[i];
+      for (int f = 0; f < 4; ++f) {
+        Ch nb = c->neighbor(f);
+        if (c->vertex(f) == v || nb->info().w.label != c->info().w.label)
+          continue;
+        uint32_t a = find(uint32_t(i)), b = find(nb->info().w.local);
+        if (a != b)
+          parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+    std::vector<uint32_t> &size = size_;
+    size.assign(k, 0);
+    std::vector<uint8_t> fixed(k, 0);
+    int pieces[3] = {0, 0, 0};
+    for (size_t i = 0; i < k; ++i) {
+      uint32_t r = find(uint32_t(i));
+      if (size[r]++ == 0)
+        ++pieces[inc[r]->info().w.label];
+      if (dt_.is_infinite(inc[i]) || inc[i]->info().w.moved >= max_moves)
+        fixed[r] = 1;
+    }
+    if (pieces[kInside] <= 1 && pieces[kOutside] <= 1)
+      return true;
+    uint32_t pick = UINT32_MAX;
+    bool pick_split = false;
+    for (size_t i = 0; i < k; ++i) {
+      if (find(uint32_t(i)) != i || fixed[i])
+        continue;
+      bool split = pieces[inc[i]->info().w.label] > 1;
+      if (pick == UINT32_MAX || (split && !pick_split) ||
+          (split == pick_split && size[i] < size[pick])) {
+        pick = uint32_t(i);
+        pick_split = split;
+      }
+    }
+    if (pick == UINT32_MAX)
+      return false;
+    const uint8_t to =
+        inc[pick]->info().w.label == kInside ? kOutside : kInside;
+    for (size_t i = 0; i < k; ++i) {
+      if (find(uint32_t(i)) != pick)
+        continue;
+      inc[i]->info().w.label = to;
+      ++inc[i]->info().w.moved;
+      ++diag.cells_relabelled;
+      for (int j = 0; j < 4; ++j)
+        if (!dt_.is_infinite(inc[i]->vertex(j)))
+          touched.push_back(inc[i]->vertex(j));
+    }
+    return true;
+  }
+
+  // Whether vertex d lies in front of (on the normal side of) the oriented
+  // triangle t (vertex numbers), by an exact predicate: no Delaunay cell is
+  // flat, so the answer is never a tie.
+  bool front(const uint32_t *t, Vh d) const {
+    return CGAL::orientation(vh_[t[0]]->point(), vh_[t[1]]->point(),
+                             vh_[t[2]]->point(),
+                             d->point()) == CGAL::POSITIVE;
+  }
+  // Whether cell c lies in front of its facet f, the triangle t.
+  bool in_front(const uint32_t *t, Ch c, int f) const {
+    if (!dt_.is_infinite(c->vertex(f)))
+      return front(t, c->vertex(f));
+    Ch nb = c->neighbor(f);
+    return !front(t, nb->vertex(nb->index(c)));
+  }
+
+  // Flips every edge-connected component of tris whose votes (+1 for a
+  // hull triangle facing the infinite cell, -1 for one facing away) add up
+  // to less than zero.
+  static void flip_inward_components(std::vector<uint32_t> &tris,
+                                     const std::vector<int8_t> &votes) {
+    const size_t nt = tris.size() / 3;
+    std::vector<std::pair<uint64_t, uint32_t>> edges;
+    edges.reserve(3 * nt);
+    for (size_t t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k) {
+        uint64_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3];
+        edges.emplace_back(a < b ? (a << 32) | b : (b << 32) | a,
+                           uint32_t(t));
+      }
+    std::sort(edges.begin(), edges.end());
+    std::vector<uint32_t> parent(nt);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto find = [&](uint32_t x) {
+      while (parent[x] != x)
+        x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    for (size_t i = 1; i < edges.size(); ++i)
+      if (edges[i].first == edges[i - 1].first) {
+        uint32_t a = find(edges[i].second), b = find(edges[i - 1].second);
+        if (a != b)
+          parent[std::max(a, b)] = std::min(a, b);
+      }
+    std::vector<int64_t> score(nt, 0);
+    for (size_t t = 0; t < nt; ++t)
+      score[find(uint32_t(t))] += votes[t];
+    for (size_t t = 0; t < nt; ++t)
+      if (score[find(uint32_t(t))] < 0)
+        std::swap(tris[3 * t + 1], tris[3 * t + 2]);
+  }
+
+  void vote(Ch c, uint8_t label) {
+    CellLabel &w = c->info().w;
+    if (label == kInside && w.vin < UINT16_MAX)
+      ++w.vin;
+    if (label == kOutside && w.vout < UINT16_MAX)
+      ++w.vout;
+  }
+
   void select_candidates(const sc_params_t &params, Progress &progress,
                          std::vector<uint32_t> &tris, sc_diag_t &diag) {
     Criteria cr(params);
+    const bool detect = detects_boundary(params.mode);
     size_t cells = dt_.number_of_cells(), k = 0;
     V3 P[3], poles[3];
+    bool interior[3] = {true, true, true};
     uint32_t idx[3];
     const Vh inf = dt_.infinite_vertex();
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
@@ -421,6 +924,8 @@ private:
           P[j] = v3(v->point());
           poles[j] = {d.pole[0], d.pole[1], d.pole[2]};
           idx[j] = d.idx;
+          if (detect)
+            interior[j] = (d.flags & kVInterior) != 0;
         }
         V3 other;
         if (ray) {
@@ -432,7 +937,7 @@ private:
           const float *oc = nb->info().cc;
           other = {oc[0], oc[1], oc[2]};
         }
-        if (is_candidate(cr, P, poles, cc, other, ray)) {
+        if (is_candidate(cr, P, poles, interior, cc, other, ray)) {
           tris.push_back(idx[0]);
           tris.push_back(idx[1]);
           tris.push_back(idx[2]);
@@ -442,6 +947,9 @@ private:
   }
 
   DT dt_;
+  std::vector<Vh> vh_; // vertex number -> handle, while closing
+  std::vector<Ch> star_; // scratch of repair_vertex()
+  std::vector<uint32_t> parent_, size_;
 };
 
 #ifdef CGAL_LINKED_WITH_TBB

@@ -22,6 +22,11 @@ namespace sc {
 // triangulation dominates); used for admission control by the daemon.
 constexpr uint64_t kBytesPerPoint = 1100;
 
+// Defaults of the boundary detection (see the README for the measurements
+// behind them); a parameter of 0 stands for these.
+constexpr double kDefaultRho = 1.3;
+constexpr double kDefaultAlpha = 0.35;
+
 // An error with a code from the public table, thrown inside the core and
 // turned into a return value at the C boundary.
 struct Error : std::runtime_error {
@@ -67,7 +72,16 @@ struct Filtered {
   std::vector<double> poles;      // 3 per vertex: unit pole direction
   std::vector<uint32_t> to_input; // vertex number -> input index
   std::vector<std::pair<uint32_t, uint32_t>> dups; // (duplicate, first), input
+  // Per vertex: 1 for a boundary sample (boundary detection ran and found
+  // the sample not interior); empty when detection did not run.
+  std::vector<uint8_t> boundary;
 };
+
+// Whether a mode sorts samples into interior and boundary ones.
+inline bool detects_boundary(int mode) {
+  return mode == SC_MODE_BOUNDARY || mode == SC_MODE_WATERTIGHT ||
+         mode == SC_MODE_AUTO;
+}
 
 // The Delaunay-dependent stages, behind an interface so that the sequential
 // and the parallel triangulation share the rest of the pipeline.
@@ -79,9 +93,18 @@ public:
                       Progress &progress) = 0;
   virtual int dimension() const = 0;
   // Resolves duplicates, then runs poles and candidates, filling diag.
+  // Frees the triangulation at the end unless `keep`.
   virtual void filter(const double *xyz, size_t n, const sc_params_t &params,
                       Progress &progress, Filtered &out, sc_diag_t &diag,
-                      double seconds[SC_STAGE_COUNT]) = 0;
+                      double seconds[SC_STAGE_COUNT], bool keep) = 0;
+  // Watertight mode, on a triangulation kept by filter(): labels the cells
+  // inside or outside across the oriented surface tris (vertex numbers) and
+  // replaces tris by the boundary of the inside cells, repaired into a
+  // 2-manifold as far as relabelling goes (a few pinched vertices may be
+  // left). Returns false, leaving tris as it was, when no cell is inside.
+  // Frees the triangulation.
+  virtual bool close(std::vector<uint32_t> &tris, Progress &progress,
+                     sc_diag_t &diag) = 0;
 };
 
 std::unique_ptr<Triangulator> make_triangulator(int threads,
@@ -93,12 +116,30 @@ struct Surface {
   std::vector<uint32_t> tris;
   std::vector<int32_t> component_genus;
 };
+// keep_vertex, when not empty, marks the vertices at which no edge is ever
+// sharp (boundary samples).
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
-           bool erode_single, std::vector<uint8_t> &alive, Progress &progress,
-           sc_diag_t &diag);
+           bool erode_single, const std::vector<uint8_t> &keep_vertex,
+           std::vector<uint8_t> &alive, Progress &progress, sc_diag_t &diag);
+// Holes mostly rimmed by samples marked in boundary are left open.
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, size_t max_hole,
-             Progress &progress, Surface &out, sc_diag_t &diag);
+             const std::vector<uint8_t> &boundary, Progress &progress,
+             Surface &out, sc_diag_t &diag);
+// The topology of a finished surface: components, boundary loops, genus,
+// manifold checks; closed components facing inward are flipped. Resets and
+// fills the output fields of diag (triangles, boundary, components ...).
+void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
+              Progress &progress, Surface &out, sc_diag_t &diag);
+// Removes every triangle on an edge with more than two, then keeps the
+// largest fan at each vertex: what is left is a 2-manifold (with boundary).
+void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
+                      Progress &progress);
+// Closes every hole of at most max_loop edges by a least-area patch, except
+// loops mostly of samples marked in boundary (which may be empty).
+void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &tris,
+                size_t max_loop, const std::vector<uint8_t> &boundary,
+                Progress &progress, sc_diag_t &diag);
 
 // One reconstruction, fed all at once or in chunks.
 class Recon {

@@ -18,6 +18,9 @@ namespace sc {
 namespace {
 
 constexpr size_t kMaxPoints = 0xFFFFFFFEu;
+// The longest hole the watertight fallback fills: the least-area patch
+// costs the cube of the loop's length.
+constexpr size_t kMaxFillLoop = 2000;
 
 void check_finite(const double *xyz, size_t n, size_t first) {
   for (size_t i = 0; i < 3 * n; ++i) {
@@ -113,8 +116,17 @@ sc_mesh_t *Recon::finish() {
   }
 
   Filtered f;
-  dt_->filter(xyz_, n_, params_, progress, f, diag, seconds_);
-  dt_.reset();
+  const bool watertight = params_.mode == SC_MODE_WATERTIGHT;
+  dt_->filter(xyz_, n_, params_, progress, f, diag, seconds_, watertight);
+  if (!watertight)
+    dt_.reset();
+  diag.path = params_.mode == SC_MODE_SHORTCRUST ? SC_PATH_SHORTCRUST
+              : params_.mode == SC_MODE_COCONE   ? SC_PATH_COCONE
+                                                 : SC_PATH_BOUNDARY;
+  // Auto mode: with no boundary sample found this is a closed surface, and
+  // boundary mode then is the cocone test exactly.
+  if (params_.mode == SC_MODE_AUTO && diag.boundary_samples == 0)
+    diag.path = SC_PATH_COCONE;
 
   Stopwatch sw;
   progress.stage(SC_STAGE_PRUNE);
@@ -125,14 +137,49 @@ sc_mesh_t *Recon::finish() {
     std::memcpy(&lxyz[3 * k], xyz_ + 3 * size_t(f.to_input[k]),
                 3 * sizeof(double));
   std::vector<uint8_t> alive;
-  prune(lxyz.data(), m, f.tris, params_.paper_pruning != 0, alive, progress,
-        diag);
+  prune(lxyz.data(), m, f.tris, params_.paper_pruning != 0, f.boundary, alive,
+        progress, diag);
   seconds_[SC_STAGE_PRUNE] += sw.lap();
 
   progress.stage(SC_STAGE_EXTRACT);
   Surface surf;
-  extract(lxyz.data(), m, f.tris, alive, size_t(params_.max_hole_edges),
+  // Watertight mode closes every hole by labelling cells, so nothing is
+  // filled before that.
+  extract(lxyz.data(), m, f.tris, alive,
+          watertight ? 0 : size_t(params_.max_hole_edges), f.boundary,
           progress, surf, diag);
+  if (watertight) {
+    std::vector<uint32_t> extracted = surf.tris, closed = surf.tris;
+    const uint64_t loops = diag.boundary_loops, before = diag.triangles;
+    diag.path = SC_PATH_WATERTIGHT;
+    if (dt_->close(closed, progress, diag)) {
+      describe(lxyz.data(), m, closed, progress, surf, diag);
+      if (diag.nonmanifold_edges || diag.nonmanifold_vertices) {
+        // Relabelling left a few pinches: cut them out and close the small
+        // holes that leaves.
+        drop_nonmanifold(lxyz.data(), m, surf.tris, progress);
+        fill_holes(lxyz.data(), m, surf.tris, kMaxFillLoop, {}, progress, diag);
+        describe(lxyz.data(), m, surf.tris, progress, surf, diag);
+      }
+    } else {
+      diag.path = SC_PATH_WATERTIGHT_FILL;
+    }
+    dt_.reset();
+    if (!diag.closed || diag.nonmanifold_edges || diag.nonmanifold_vertices)
+      diag.path = SC_PATH_WATERTIGHT_FILL;
+    if (diag.path == SC_PATH_WATERTIGHT_FILL) {
+      // The labelling did not give a closed manifold: close the holes of
+      // the extracted surface by least-area patches instead, as large as
+      // the dynamic programme allows.
+      describe(lxyz.data(), m, extracted, progress, surf, diag);
+      fill_holes(lxyz.data(), m, surf.tris, kMaxFillLoop, {}, progress, diag);
+      describe(lxyz.data(), m, surf.tris, progress, surf, diag);
+    }
+    // Every loop of the extracted surface was closed if the result is.
+    diag.holes_filled = diag.closed ? loops : 0;
+    diag.hole_triangles =
+        diag.triangles > before ? diag.triangles - before : 0;
+  }
 
   // Per-vertex normals: the pole direction, signed to agree with the
   // area-weighted normal of the output triangles around the vertex.

@@ -55,6 +55,20 @@ typedef enum sc_mode {
   /* The cocone test: the dual Voronoi edge meets the cocone of all three
    * vertices. */
   SC_MODE_COCONE = 1,
+  /* For scans with a boundary (ALGORITHM.md section 6): samples are sorted
+   * into interior and boundary ones (Dey and Giesen's ratio and normal
+   * tests, parameters boundary_rho and boundary_alpha); the cocone test is
+   * made only at interior vertices, and no edge at a boundary sample is
+   * pruned, so the output is a 2-manifold with boundary. */
+  SC_MODE_BOUNDARY = 2,
+  /* Boundary mode, then holes are closed by labelling the Delaunay cells
+   * inside or outside across the surface: the output is the boundary of the
+   * inside cells, a closed 2-manifold. */
+  SC_MODE_WATERTIGHT = 3,
+  /* For input not known to be closed: the cocone test where the samples
+   * look like a closed surface, boundary mode where they do not (diag.path
+   * says which was taken). */
+  SC_MODE_AUTO = 4,
   /* Count of modes; not a mode. */
   SC_MODE_COUNT_
 } sc_mode_t;
@@ -111,6 +125,16 @@ typedef struct sc_params {
   /* Optional progress and cancellation; NULL for none. */
   sc_progress_fn progress;
   void *progress_user;
+  /* Boundary detection (boundary, watertight and auto modes). A sample
+   * passes the ratio test when the farthest Voronoi vertex of its cell
+   * inside its cocone is at most boundary_rho times the distance to its
+   * negative pole; in (0, 10], default 1.3; 0 means the default (so that a
+   * caller written before this field existed keeps working). */
+  double boundary_rho;
+  /* Poles of neighbouring interior samples agree when the angle between
+   * them (unoriented) is at most this, radians, in (0, pi/2]; default
+   * 0.35 (20 degrees); 0 means the default. */
+  double boundary_alpha;
 } sc_params_t;
 
 /* Fills *p with the documented defaults. */
@@ -143,7 +167,32 @@ typedef struct sc_diag {
   int64_t genus;               /* sum of the genera of closed components */
   double seconds[SC_STAGE_COUNT]; /* wall time per stage */
   double seconds_total;
+  /* The path taken, one of the SC_PATH_ values below: what auto mode chose,
+   * and whether watertight mode closed the surface by labelling cells or had
+   * to fall back to filling holes. */
+  int path;
+  uint64_t boundary_samples;  /* samples found not interior (0 in the
+                                 shortcrust and cocone modes) */
+  uint64_t longest_loop;      /* edges in the longest boundary loop */
+  /* Boundary loops by length in edges: 3-10, 11-100, 101-1000, > 1000. */
+  uint64_t loops_by_length[4];
+  uint64_t cells_relabelled;  /* watertight: cells moved to the other label
+                                 to make the surface a manifold */
 } sc_diag_t;
+
+/* Values of sc_diag_t.path. */
+typedef enum sc_path {
+  SC_PATH_SHORTCRUST = 0,      /* the paper's criteria */
+  SC_PATH_COCONE = 1,          /* the cocone test everywhere */
+  SC_PATH_BOUNDARY = 2,        /* the cocone test at interior samples only */
+  SC_PATH_WATERTIGHT = 3,      /* closed by labelling cells */
+  SC_PATH_WATERTIGHT_FILL = 4, /* labelling failed; holes filled instead */
+  SC_PATH_COUNT_
+} sc_path_t;
+
+/* Short name of a path ("cocone", "boundary", "watertight-fill", ...);
+ * "?" when out of range. */
+const char *sc_path_name(int path);
 
 /* The result of a reconstruction. Free with sc_mesh_free(). */
 typedef struct sc_mesh {

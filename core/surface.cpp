@@ -215,6 +215,44 @@ int count_fans(uint32_t v, const std::vector<uint32_t> &star,
   return fans;
 }
 
+// A vertex whose triangles form several fans is pinched: keep its largest
+// fan. Removing triangles can pinch their other vertices, so repeat until
+// every vertex has one fan. Clears in[t] for the triangles removed.
+void fix_fans(size_t n, const std::vector<uint32_t> &otri,
+              std::vector<uint8_t> &in) {
+  VertexStar ostar;
+  ostar.build(n, otri, [&](size_t t) { return in[t] != 0; });
+  std::vector<uint32_t> work;
+  for (uint32_t v = 0; v < n; ++v)
+    if (ostar.first[v + 1] > ostar.first[v])
+      work.push_back(v);
+  std::vector<uint32_t> cur;
+  std::vector<int> fan_of;
+  while (!work.empty()) {
+    uint32_t v = work.back();
+    work.pop_back();
+    cur.clear();
+    for (uint32_t i = ostar.first[v]; i < ostar.first[v + 1]; ++i)
+      if (in[ostar.tris[i]])
+        cur.push_back(ostar.tris[i]);
+    int fans = count_fans(v, cur, otri, fan_of);
+    if (fans <= 1)
+      continue;
+    std::vector<size_t> size(fans, 0);
+    for (int f : fan_of)
+      ++size[f];
+    int keep = int(std::max_element(size.begin(), size.end()) - size.begin());
+    for (size_t i = 0; i < cur.size(); ++i) {
+      if (fan_of[i] == keep)
+        continue;
+      in[cur[i]] = 0;
+      for (int k = 0; k < 3; ++k)
+        if (otri[3 * size_t(cur[i]) + k] != v)
+          work.push_back(otri[3 * size_t(cur[i]) + k]);
+    }
+  }
+}
+
 double signed_volume6(const double *xyz, const uint32_t *t, const double *o) {
   const double *a = xyz + 3 * size_t(t[0]), *b = xyz + 3 * size_t(t[1]),
                *c = xyz + 3 * size_t(t[2]);
@@ -241,13 +279,18 @@ bool is_triangle_of(const EdgeTable &et, const std::vector<uint32_t> &tris,
   return false;
 }
 
+} // namespace
+
 // Closes the holes of an edge-manifold, consistently oriented, vertex-
 // manifold surface whose boundary loops have at most max_loop edges. Each
 // hole is triangulated over its own loop by dynamic programming for the
 // least total area, never creating an edge the surface already has, so the
 // result stays a manifold.
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
-                size_t max_loop, Progress &progress, sc_diag_t &diag) {
+                size_t max_loop, const std::vector<uint8_t> &boundary,
+                Progress &progress, sc_diag_t &diag) {
+  if (res.empty())
+    return;
   EdgeTable et;
   et.build(xyz, n, res, progress);
   // Chords added by earlier fills count as existing edges too: two holes
@@ -300,6 +343,15 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     }
     if (!ok || v != v0 || loop.size() < 3 || loop.size() > max_loop)
       continue;
+    // A loop mostly of boundary samples is where the surface ends, not a
+    // hole left by a missing triangle.
+    if (!boundary.empty()) {
+      size_t on = 0;
+      for (uint32_t w : loop)
+        on += boundary[w];
+      if (2 * on >= loop.size())
+        continue;
+    }
     const size_t L = loop.size();
     // A three-edge loop around a lone triangle would be closed by a second
     // copy of that triangle.
@@ -363,11 +415,9 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
   }
 }
 
-} // namespace
-
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
-           bool erode_single, std::vector<uint8_t> &alive, Progress &progress,
-           sc_diag_t &diag) {
+           bool erode_single, const std::vector<uint8_t> &keep_vertex,
+           std::vector<uint8_t> &alive, Progress &progress, sc_diag_t &diag) {
   EdgeTable et;
   et.build(xyz, n, cand, progress);
   const size_t ne = et.edges();
@@ -403,6 +453,14 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     uint32_t e = work.back();
     work.pop_back();
     queued[e] = 0;
+    // Boundary mode: a boundary sample has a lone triangle, or a wedge of
+    // them, on its edges by nature; pruning there would eat the surface
+    // from its boundary inward.
+    if (!keep_vertex.empty()) {
+      uint64_t k = et.entries[et.first[e]].key;
+      if (keep_vertex[key_lo(k)] || keep_vertex[uint32_t(k)])
+        continue;
+    }
     if (!is_sharp(et, e, alive, erode_single)) {
       if (erode_single || !dangling(e))
         continue;
@@ -426,7 +484,8 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, size_t max_hole,
-             Progress &progress, Surface &out, sc_diag_t &diag) {
+             const std::vector<uint8_t> &boundary, Progress &progress,
+             Surface &out, sc_diag_t &diag) {
   const size_t nt = cand.size() / 3;
   // Only the survivors of pruning take part.
   std::vector<uint32_t> live;
@@ -608,40 +667,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     ++comps;
   }
 
-  // A vertex whose triangles form several fans is pinched: keep its largest
-  // fan. Removing triangles can pinch their other vertices, so repeat until
-  // every vertex has one fan.
-  VertexStar ostar;
-  ostar.build(n, otri, [&](size_t t) { return in[t] != 0; });
-  std::vector<uint32_t> work;
-  for (uint32_t v = 0; v < n; ++v)
-    if (ostar.first[v + 1] > ostar.first[v])
-      work.push_back(v);
-  std::vector<uint32_t> cur;
-  std::vector<int> fan_of;
-  while (!work.empty()) {
-    uint32_t v = work.back();
-    work.pop_back();
-    cur.clear();
-    for (uint32_t i = ostar.first[v]; i < ostar.first[v + 1]; ++i)
-      if (in[ostar.tris[i]])
-        cur.push_back(ostar.tris[i]);
-    int fans = count_fans(v, cur, otri, fan_of);
-    if (fans <= 1)
-      continue;
-    std::vector<size_t> size(fans, 0);
-    for (int f : fan_of)
-      ++size[f];
-    int keep = int(std::max_element(size.begin(), size.end()) - size.begin());
-    for (size_t i = 0; i < cur.size(); ++i) {
-      if (fan_of[i] == keep)
-        continue;
-      in[cur[i]] = 0;
-      for (int k = 0; k < 3; ++k)
-        if (otri[3 * size_t(cur[i]) + k] != v)
-          work.push_back(otri[3 * size_t(cur[i]) + k]);
-    }
-  }
+  fix_fans(n, otri, in);
 
   // The output, its components (triangles sharing an edge), and their
   // topology. Closed components facing inward are flipped.
@@ -651,7 +677,38 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
       res.insert(res.end(), &otri[3 * t], &otri[3 * t] + 3);
   diag.walk_rejected = nl - res.size() / 3;
   if (max_hole >= 3)
-    fill_holes(xyz, n, res, max_hole, progress, diag);
+    fill_holes(xyz, n, res, max_hole, boundary, progress, diag);
+  describe(xyz, n, res, progress, out, diag);
+}
+
+void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
+                      Progress &progress) {
+  const size_t nt = tris.size() / 3;
+  EdgeTable et;
+  et.build(xyz, n, tris, progress);
+  std::vector<uint8_t> in(nt, 1);
+  for (size_t e = 0; e < et.edges(); ++e)
+    if (et.first[e + 1] - et.first[e] > 2)
+      for (uint32_t i = et.first[e]; i < et.first[e + 1]; ++i)
+        in[et.entries[i].tri] = 0;
+  fix_fans(n, tris, in);
+  std::vector<uint32_t> res;
+  for (size_t t = 0; t < nt; ++t)
+    if (in[t])
+      res.insert(res.end(), &tris[3 * t], &tris[3 * t] + 3);
+  tris.swap(res);
+}
+
+void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
+              Progress &progress, Surface &out, sc_diag_t &diag) {
+  diag.triangles = diag.boundary_edges = diag.boundary_loops = 0;
+  diag.nonmanifold_edges = diag.nonmanifold_vertices = 0;
+  diag.components = diag.closed_components = 0;
+  diag.longest_loop = 0;
+  for (uint64_t &l : diag.loops_by_length)
+    l = 0;
+  std::vector<uint32_t> cur;
+  std::vector<int> fan_of;
   const size_t nr = res.size() / 3;
   EdgeTable rt;
   rt.build(xyz, n, res, progress);
@@ -685,6 +742,21 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
       on_boundary[key_lo(k)] = on_boundary[uint32_t(k)] = 1;
     } else if (cnt > 2) {
       ++diag.nonmanifold_edges;
+    }
+  }
+  // Loop lengths: boundary edges per loop (loops that touch at a vertex
+  // count as one).
+  {
+    std::vector<uint64_t> loop_edges(n, 0);
+    for (size_t e = 0; e < rt.edges(); ++e)
+      if (rt.first[e + 1] - rt.first[e] == 1)
+        ++loop_edges[bloops.find(key_lo(rt.entries[rt.first[e]].key))];
+    for (uint32_t v = 0; v < n; ++v) {
+      uint64_t len = loop_edges[v];
+      if (len == 0)
+        continue;
+      diag.longest_loop = std::max(diag.longest_loop, len);
+      ++diag.loops_by_length[len <= 10 ? 0 : len <= 100 ? 1 : len <= 1000 ? 2 : 3];
     }
   }
   std::vector<int32_t> vcomp(n, -1);
