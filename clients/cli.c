@@ -29,6 +29,9 @@ void sc_cli_error(const char *fmt, ...) {
 static const char *const mode_names[SC_MODE_COUNT_] = {
     [SC_MODE_SHORTCRUST] = "shortcrust",
     [SC_MODE_COCONE] = "cocone",
+    [SC_MODE_BOUNDARY] = "boundary",
+    [SC_MODE_WATERTIGHT] = "watertight",
+    [SC_MODE_AUTO] = "auto",
 };
 
 const char *sc_cli_mode_name(sc_mode_t mode) {
@@ -190,7 +193,12 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
     fprintf(f, ", %llu small hole%s filled",
             (unsigned long long)d->holes_filled,
             d->holes_filled == 1 ? "" : "s");
-  fprintf(f, ".\nTime: read %.3f s", r->seconds_read);
+  fprintf(f, ".\n");
+  fprintf(f, "Path %s: %llu boundary sample%s, longest loop %llu edges.\n",
+          sc_path_name(d->path), (unsigned long long)d->boundary_samples,
+          d->boundary_samples == 1 ? "" : "s",
+          (unsigned long long)d->longest_loop);
+  fprintf(f, "Time: read %.3f s", r->seconds_read);
   if (r->seconds_transfer > 0)
     fprintf(f, ", transfer %.3f s", r->seconds_transfer);
   for (int s = 0; s < SC_STAGE_COUNT; ++s)
@@ -229,9 +237,11 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
   json_string(f, sc_cli_mode_name(r->params.mode));
   fprintf(f,
           ", \"r\": %.17g, \"cocone_theta\": %.17g, \"paper_pruning\": %d, "
-          "\"max_hole_edges\": %d, \"threads\": %d},\n",
+          "\"max_hole_edges\": %d, \"threads\": %d, \"boundary_rho\": %.17g, "
+          "\"boundary_alpha\": %.17g},\n",
           r->params.r, r->params.cocone_theta, r->params.paper_pruning,
-          r->params.max_hole_edges, r->params.threads);
+          r->params.max_hole_edges, r->params.threads, r->params.boundary_rho,
+          r->params.boundary_alpha);
 #define U64_(field) fprintf(f, "  \"" #field "\": %llu,\n", (unsigned long long)d->field)
   U64_(points_in);
   U64_(duplicates_merged);
@@ -253,7 +263,17 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
   U64_(nonmanifold_vertices);
   U64_(components);
   U64_(closed_components);
+  U64_(boundary_samples);
+  U64_(longest_loop);
+  U64_(cells_relabelled);
 #undef U64_
+  fputs("  \"path\": ", f);
+  json_string(f, sc_path_name(d->path));
+  fprintf(f, ",\n  \"loops_by_length\": [%llu, %llu, %llu, %llu],\n",
+          (unsigned long long)d->loops_by_length[0],
+          (unsigned long long)d->loops_by_length[1],
+          (unsigned long long)d->loops_by_length[2],
+          (unsigned long long)d->loops_by_length[3]);
   fprintf(f, "  \"closed\": %s,\n", d->closed ? "true" : "false");
   fprintf(f, "  \"euler\": %lld,\n  \"genus\": %lld,\n", (long long)d->euler,
           (long long)d->genus);

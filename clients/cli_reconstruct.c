@@ -30,7 +30,9 @@ static void usage(FILE *f) {
       "point is written, in input order, so triangle indices refer to IN.\n\n"
       "options:\n"
       "  -o, --output OUT      the mesh to write (required)\n"
-      "  -m, --mode MODE       candidate test: cocone or shortcrust "
+      "  -m, --mode MODE       cocone, shortcrust, boundary (scans with a "
+      "boundary),\n"
+      "                        watertight (close every hole) or auto "
       "(default %s)\n"
       "      --r R             shortcrust sampling parameter, in (0, 0.5) "
       "(default %g)\n"
@@ -40,6 +42,12 @@ static void usage(FILE *f) {
       "(default %d)\n"
       "      --paper-pruning   prune every edge with a single candidate, as "
       "in the paper\n"
+      "      --rho RHO         boundary detection: ratio of cocone extent to "
+      "pole height,\n"
+      "                        in (0, 10] (default %g)\n"
+      "      --alpha DEG       boundary detection: largest angle between "
+      "neighbouring\n"
+      "                        poles, in (0, 90] degrees (default %g)\n"
       "  -j, --threads N       threads for the Delaunay triangulation, 0 = "
       "one per core\n"
       "                        (default %d)\n"
@@ -52,11 +60,12 @@ static void usage(FILE *f) {
       "stdout. Exit status: 0 done, 1 failed (the message says why), 2 bad\n"
       "command line.\n",
       sc_cli_mode_name(d.mode), d.r, d.cocone_theta * 180 / SC_PI,
-      d.max_hole_edges, d.threads);
+      d.max_hole_edges, d.boundary_rho, d.boundary_alpha * 180 / SC_PI,
+      d.threads);
 }
 
 enum { OPT_R = 256, OPT_THETA, OPT_MAX_HOLE, OPT_PAPER, OPT_REPORT, OPT_ASCII,
-       OPT_NO_NORMALS };
+       OPT_NO_NORMALS, OPT_RHO, OPT_ALPHA };
 
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},
@@ -65,6 +74,8 @@ static const struct option long_options[] = {
     {"theta", required_argument, NULL, OPT_THETA},
     {"max-hole", required_argument, NULL, OPT_MAX_HOLE},
     {"paper-pruning", no_argument, NULL, OPT_PAPER},
+    {"rho", required_argument, NULL, OPT_RHO},
+    {"alpha", required_argument, NULL, OPT_ALPHA},
     {"threads", required_argument, NULL, 'j'},
     {"report", required_argument, NULL, OPT_REPORT},
     {"ascii", no_argument, NULL, OPT_ASCII},
@@ -109,6 +120,23 @@ int sc_cmd_reconstruct(int argc, char **argv) {
       break;
     case OPT_PAPER:
       params.paper_pruning = 1;
+      break;
+    case OPT_RHO:
+      if (sc_cli_parse_double("--rho", optarg, &params.boundary_rho) < 0)
+        return SC_EXIT_USAGE;
+      if (!(params.boundary_rho > 0)) {
+        sc_cli_error("--rho: must be positive, got %s", optarg);
+        return SC_EXIT_USAGE;
+      }
+      break;
+    case OPT_ALPHA:
+      if (sc_cli_parse_double("--alpha", optarg, &v) < 0)
+        return SC_EXIT_USAGE;
+      if (!(v > 0)) {
+        sc_cli_error("--alpha: must be positive, got %s", optarg);
+        return SC_EXIT_USAGE;
+      }
+      params.boundary_alpha = v * SC_PI / 180;
       break;
     case 'j':
       if (sc_cli_parse_int("--threads", optarg, 0, 1024, &l) < 0)
