@@ -526,6 +526,14 @@ static void send_job_done(scd_conn_t *c, scd_job_t *j) {
       F("seconds.prune", d->seconds[SC_STAGE_PRUNE]),
       F("seconds.extract", d->seconds[SC_STAGE_EXTRACT]),
       F("seconds.total", d->seconds_total),
+      U("path", d->path),
+      U("boundary_samples", d->boundary_samples),
+      U("longest_loop", d->longest_loop),
+      U("loops.3_10", d->loops_by_length[0]),
+      U("loops.11_100", d->loops_by_length[1]),
+      U("loops.101_1000", d->loops_by_length[2]),
+      U("loops.over_1000", d->loops_by_length[3]),
+      U("cells_relabelled", d->cells_relabelled),
       F("seconds.upload", ms_between(j->begin_ns, j->end_ns) / 1e3),
       F("seconds.server", ms_between(j->begin_ns, uv_hrtime()) / 1e3),
   };
@@ -775,7 +783,9 @@ static void on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
     refuse_job(c, id, SCP_WIRE_SHUTDOWN, "server shutting down");
     return;
   }
-  if (m.mode != SCP_MODE_SHORTCRUST && m.mode != SCP_MODE_COCONE) {
+  /* The protocol numbers modes like the core; a mode the core was built
+   * without is refused. */
+  if (m.mode >= (uint32_t)SC_MODE_COUNT_) {
     refuse_job(c, id, SCP_WIRE_UNSUPPORTED,
                "mode %s is not supported by this server",
                scp_mode_name(m.mode));
@@ -812,8 +822,7 @@ static void on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
     scd_conn_close_now(c, "out of memory");
     return;
   }
-  t->params.mode = m.mode == SCP_MODE_SHORTCRUST ? SC_MODE_SHORTCRUST
-                                                 : SC_MODE_COCONE;
+  t->params.mode = (sc_mode_t)m.mode;
   t->params.r = m.r;
   if (m.theta != 0)
     t->params.cocone_theta = m.theta;

@@ -288,6 +288,27 @@ int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {
   return ok;
 }
 
+int scdt_mesh_closed(const scdt_job_t *j, char *why, size_t len) {
+  if (!j->done) {
+    snprintf(why, len, "job %u did not finish: error %s: %s", j->id,
+             scp_wire_name(j->error_code), j->error_msg);
+    return 0;
+  }
+  sc_meshcheck_t mc;
+  if (sc_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SC_TS_OK) {
+    snprintf(why, len, "job %u: mesh check failed to run", j->id);
+    return 0;
+  }
+  int ok = mc.closed && mc.oriented;
+  if (!ok) {
+    char sum[512];
+    snprintf(why, len, "job %u: not a closed oriented manifold: %s", j->id,
+             sc_meshcheck_summary(&mc, sum, sizeof sum));
+  }
+  sc_meshcheck_free(&mc);
+  return ok;
+}
+
 uint64_t scdt_stat_fresh(const char *sock, const char *name) {
   scdt_conn_t *c;
   if (scdt_open(sock, SCP_FRAME_MIN, &c) != 0)

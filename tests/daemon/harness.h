@@ -104,6 +104,10 @@ double *scdt_sample_random(int surface, size_t n, uint64_t seed);
  * with the reason in why. */
 int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len);
 
+/* 1 when job j came back as a closed, oriented 2-manifold over its own
+ * points, whatever its genus; otherwise 0 with the reason in why. */
+int scdt_mesh_closed(const scdt_job_t *j, char *why, size_t len);
+
 /* A STATS value read on a fresh connection; UINT64_MAX when that fails. */
 uint64_t scdt_stat_fresh(const char *sock, const char *name);
 /* Polls scdt_stat_fresh() until the value equals want or timeout_ms pass;

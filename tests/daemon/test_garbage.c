@@ -237,11 +237,13 @@ static void invalid_requests(void) {
   CHECK(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
   b.len = 0;
 
-  /* A mode this server does not implement. */
+  /* A mode version 1 does not have. */
+  scp_enc_job_begin(&b, &jb);
+  b.data[8 + 4] = 5;
+  CHECK(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
+  b.len = 0;
   scdt_job_reset(&j);
-  j.mode = SCP_MODE_WATERTIGHT;
-  CHECK(scdt_job_begin(c, &j) == 0, "send");
-  expect_job_error(c, &j, SCP_WIRE_UNSUPPORTED);
+  expect_job_error(c, &j, SCP_WIRE_INVALID);
   CHECK(scdt_job_cancel(c, &j) == 0, "cancel");
 
   /* Duplicate id. */

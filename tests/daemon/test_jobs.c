@@ -3,7 +3,8 @@
  * flight whose frames interleave, and every mesh checked against its own
  * points (closed manifold, outward, right genus), so that a mesh delivered
  * to the wrong job cannot pass. Half the connections use the smallest
- * frame limit, so points and meshes travel in many small chunks.
+ * frame limit, so points and meshes travel in many small chunks; jobs use
+ * every mode, f32 and f64 points, with and without normals.
  *
  *   test_daemon_jobs DAEMON CONNECTIONS JOBS_PER_CONNECTION
  *
@@ -76,6 +77,15 @@ static void *run_client(void *p) {
       for (size_t i = 0; i < 3 * n; i++)
         xyz[i] = (double)(float)xyz[i];
     jobs[k].declare = (k != 1);
+    /* Every mode goes through. How well each mode does on these sample
+     * sizes is the core's business (its own tests measure it): cocone
+     * meshes must have the surface's topology, watertight ones must be
+     * closed, and shortcrust and auto ones must be valid meshes of their
+     * job's points. */
+    static const uint32_t modes[] = {SCP_MODE_COCONE, SCP_MODE_COCONE,
+                                     SCP_MODE_WATERTIGHT, SCP_MODE_SHORTCRUST,
+                                     SCP_MODE_AUTO};
+    jobs[k].mode = modes[k % 5];
     ptrs[k] = &jobs[k];
   }
   /* Every job in flight at once, their POINTS frames interleaved. */
@@ -99,8 +109,16 @@ static void *run_client(void *p) {
   CHECK(rc == 0, "client %d: %s", a->index, why);
   for (int k = 0; k < nj; k++) {
     CHECK(jobs[k].accepted, "job %u not accepted", jobs[k].id);
-    ok = scdt_mesh_ok(surf[k], &jobs[k], why, sizeof why);
-    CHECK(ok, "%s", why);
+    if (jobs[k].mode == SCP_MODE_SHORTCRUST || jobs[k].mode == SCP_MODE_AUTO) {
+      CHECK(jobs[k].done && jobs[k].ntri > 0, "job %u (mode %s): %s",
+            jobs[k].id, scp_mode_name(jobs[k].mode), jobs[k].error_msg);
+    } else if (jobs[k].mode == SCP_MODE_WATERTIGHT) {
+      ok = scdt_mesh_closed(&jobs[k], why, sizeof why);
+      CHECK(ok, "mode watertight: %s", why);
+    } else {
+      ok = scdt_mesh_ok(surf[k], &jobs[k], why, sizeof why);
+      CHECK(ok, "mode %s: %s", scp_mode_name(jobs[k].mode), why);
+    }
     check_normals(&jobs[k]);
     free((void *)jobs[k].xyz);
     scdt_job_reset(&jobs[k]);
