@@ -42,6 +42,7 @@ struct VertexData {
   // distances to the farthest Voronoi vertex inside the cocone (r) and to
   // the negative pole (h), and the kV* flags below.
   float r2 = 0, h2 = 0;
+  float nn2 = std::numeric_limits<float>::infinity(); // nearest neighbour
   uint8_t flags = 0;
   VertexData() = default;
   VertexData(uint32_t i) : idx(i) {}
@@ -67,6 +68,12 @@ enum : uint8_t { kUnlabelled = 0, kInside = 1, kOutside = 2 };
 // circumcentre farther than this from the cell's vertices, relative to the
 // cell's longest edge (squared).
 constexpr double kMaxCentreRatio2 = 8.0 * 8.0;
+// A cell that reaches no farther into the cocone than this many times the
+// distance to the nearest sample passes the ratio test whatever the height
+// (squared): where the surface is thin (a bunny's ear) the negative pole
+// comes close and the ratio fails, but the cell does not open sideways the
+// way it does where the surface ends.
+constexpr float kNearRatio2 = 3.0f * 3.0f;
 struct CellData {
   union {
     float cc[3];  // circumcentre (guarded), set by the poles stage
@@ -530,6 +537,9 @@ private:
       const bool trusted = norm2(cc - P[0]) <= kMaxCentreRatio2 * longest2;
       for (int j = 0; j < 4; ++j) {
         VertexData &d = c->vertex(j)->info();
+        for (int i = 0; i < 4; ++i)
+          if (i != j)
+            d.nn2 = std::min(d.nn2, float(norm2(P[i] - P[j])));
         pole[j] = {d.pole[0], d.pole[1], d.pole[2]};
         V3 dv = cc - P[j];
         double len2 = norm2(dv), dp = dot(dv, pole[j]);
@@ -554,7 +564,7 @@ private:
          ++v) {
       VertexData &d = v->info();
       d.flags &= uint8_t(~(kVRatio | kVInterior));
-      if (d.h2 > 0 && d.r2 <= rho2 * d.h2)
+      if ((d.h2 > 0 && d.r2 <= rho2 * d.h2) || d.r2 <= kNearRatio2 * d.nn2)
         d.flags |= kVRatio;
       if ((d.flags & kVRatio) && !(d.flags & kVDisagree)) {
         d.flags |= kVInterior;
@@ -594,10 +604,11 @@ private:
     boundary.assign(m, 0);
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v) {
-      if (!(v->info().flags & kVInterior)) {
-        boundary[v->info().idx] = 1;
-        ++diag.boundary_samples;
-      }
+      VertexData &d = v->info();
+      if (d.flags & kVInterior)
+        continue;
+      boundary[d.idx] = (d.flags & kVRatio) ? kBoundarySample : kOpenSample;
+      ++diag.boundary_samples;
     }
   }
 
@@ -713,7 +724,12 @@ private:
     // Rounds: a vertex at which no piece may move waits for the next round,
     // which allows more moves per cell.
     std::vector<Vh> unresolved, moved;
-    for (uint8_t max_moves : {2, 8, 32, 128}) {
+    for (int round = 0; round < 6; ++round) {
+      // The first rounds leave the cells next to the surface where the
+      // surface put them, so that the repair reshapes the caps over the
+      // holes, not the surface; later rounds move any cell, more often.
+      const bool keep_seeds = round < 3;
+      const uint8_t max_moves = uint8_t(2 << (2 * (round % 3)));
       for (Vh v : unresolved)
         if (!queued[v->info().idx]) {
           queued[v->info().idx] = 1;
@@ -726,7 +742,7 @@ private:
         work.pop_back();
         queued[v->info().idx] = 0;
         moved.clear();
-        if (!repair_vertex(v, max_moves, moved, diag))
+        if (!repair_vertex(v, max_moves, keep_seeds, moved, diag))
           unresolved.push_back(v);
         for (Vh u : moved)
           if (!queued[u->info().idx]) {
@@ -766,9 +782,10 @@ private:
   // which then takes the whole star and v leaves the surface), and appends
   // the vertices of the moved cells to `touched`. A piece that holds an
   // infinite cell, or a cell moved max_moves times already, stays, so the
-  // repair ends. Returns false when no piece could move.
-  bool repair_vertex(Vh v, uint8_t max_moves, std::vector<Vh> &touched,
-                     sc_diag_t &diag) {
+  // repair ends; so does one next to a surface triangle if keep_seeds.
+  // Returns false when no piece could move.
+  bool repair_vertex(Vh v, uint8_t max_moves, bool keep_seeds,
+                     std::vector<Vh> &touched, sc_diag_t &diag) {
     std::vector<Ch> &inc = star_;
     inc.clear();
     dt_.incident_cells(v, std::back_inserter(inc));
@@ -802,7 +819,9 @@ private:
       uint32_t r = find(uint32_t(i));
       if (size[r]++ == 0)
         ++pieces[inc[r]->info().w.label];
-      if (dt_.is_infinite(inc[i]) || inc[i]->info().w.moved >= max_moves)
+      const CellLabel &w = inc[i]->info().w;
+      if (dt_.is_infinite(inc[i]) || w.moved >= max_moves ||
+          (keep_seeds && (w.vin || w.vout)))
         fixed[r] = 1;
     }
     if (pieces[kInside] <= 1 && pieces[kOutside] <= 1)

@@ -72,10 +72,15 @@ struct Filtered {
   std::vector<double> poles;      // 3 per vertex: unit pole direction
   std::vector<uint32_t> to_input; // vertex number -> input index
   std::vector<std::pair<uint32_t, uint32_t>> dups; // (duplicate, first), input
-  // Per vertex: 1 for a boundary sample (boundary detection ran and found
-  // the sample not interior); empty when detection did not run.
+  // Per vertex: 0 for an interior sample, kBoundarySample or kOpenSample
+  // for the others; empty when boundary detection did not run.
   std::vector<uint8_t> boundary;
 };
+
+// A boundary sample whose pole disagrees with its neighbours', and one
+// whose Voronoi cell opens sideways (it failed the ratio test).
+constexpr uint8_t kBoundarySample = 1;
+constexpr uint8_t kOpenSample = 3;
 
 // Whether a mode sorts samples into interior and boundary ones.
 inline bool detects_boundary(int mode) {
@@ -115,6 +120,7 @@ std::unique_ptr<Triangulator> make_triangulator(int threads,
 struct Surface {
   std::vector<uint32_t> tris;
   std::vector<int32_t> component_genus;
+  std::vector<uint8_t> in_closed; // per triangle: its component is closed
 };
 // keep_vertex, when not empty, marks the vertices at which no edge is ever
 // sharp (boundary samples).
@@ -151,6 +157,8 @@ public:
 
 private:
   void insert_range(size_t first, size_t n);
+  void close_surface(const double *lxyz, size_t m, Progress &progress,
+                     Surface &surf, sc_diag_t &diag);
   sc_params_t params_;
   std::vector<double> own_;
   const double *xyz_ = nullptr;

@@ -15,6 +15,10 @@
 namespace sc {
 namespace {
 
+// Boundary mode leaves open the loops of at least this many edges that run
+// mostly through samples whose cells open sideways (see fill_holes()).
+constexpr size_t kMinOpenLoop = 8;
+
 inline uint64_t edge_key(uint32_t a, uint32_t b) {
   return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
 }
@@ -343,13 +347,17 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     }
     if (!ok || v != v0 || loop.size() < 3 || loop.size() > max_loop)
       continue;
-    // A loop mostly of boundary samples is where the surface ends, not a
-    // hole left by a missing triangle.
-    if (!boundary.empty()) {
-      size_t on = 0;
+    // A loop of at least kMinOpenLoop edges, most of whose samples failed
+    // the ratio test (their Voronoi cells open sideways), is where the
+    // surface ends, not a hole left by a missing triangle. Loops through
+    // samples that are boundary samples only for disagreeing poles (stray
+    // samples, thin parts such as the bunny's ears) are closed like any
+    // other hole.
+    if (!boundary.empty() && loop.size() >= kMinOpenLoop) {
+      size_t opens = 0;
       for (uint32_t w : loop)
-        on += boundary[w];
-      if (2 * on >= loop.size())
+        opens += boundary[w] == kOpenSample;
+      if (2 * opens >= loop.size())
         continue;
     }
     const size_t L = loop.size();
@@ -798,6 +806,9 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
       ++diag.nonmanifold_vertices;
   }
 
+  out.in_closed.assign(nr, 0);
+  for (size_t t = 0; t < nr; ++t)
+    out.in_closed[t] = B[comp_of[t]] == 0;
   out.component_genus.assign(nc, -1);
   diag.euler = 0;
   diag.genus = 0;
