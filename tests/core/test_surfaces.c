@@ -22,6 +22,12 @@ static int mode_from_name(const char *s) {
     return SC_MODE_SHORTCRUST;
   if (strcmp(s, "cocone") == 0)
     return SC_MODE_COCONE;
+  if (strcmp(s, "boundary") == 0)
+    return SC_MODE_BOUNDARY;
+  if (strcmp(s, "watertight") == 0)
+    return SC_MODE_WATERTIGHT;
+  if (strcmp(s, "auto") == 0)
+    return SC_MODE_AUTO;
   return -1;
 }
 
@@ -71,9 +77,20 @@ int main(int argc, char **argv) {
   printf("%s %s %s n=%zu: %s (%.2f s)\n", argv[1], argv[2], argv[3], n,
          sc_meshcheck_summary(&c, line, sizeof line), t1 - t0);
   char why[256];
-  if (!sc_meshcheck_expect(&c, surf, SC_EXPECT_ALL_USED | SC_EXPECT_OUTWARD,
+  /* The modes for scans may leave out a sample or two where the boundary
+   * detection sees undersampling (at most one in a thousand). */
+  const int scan_mode = mode == SC_MODE_BOUNDARY ||
+                        mode == SC_MODE_WATERTIGHT || mode == SC_MODE_AUTO;
+  if (!sc_meshcheck_expect(&c, surf,
+                           (scan_mode ? 0u : SC_EXPECT_ALL_USED) |
+                               SC_EXPECT_OUTWARD,
                            why, sizeof why)) {
     fprintf(stderr, "FAIL: %s\n", why);
+    ++failures;
+  }
+  if (scan_mode && c.samples_unused * 1000 > n) {
+    fprintf(stderr, "FAIL: %llu of %zu samples unused\n",
+            (unsigned long long)c.samples_unused, n);
     ++failures;
   }
 

@@ -1,0 +1,268 @@
+// shortcrust-modes-table: every mode of the core, and CGAL's advancing-front
+// reconstruction beside them, on real point files; prints one Markdown
+// table.
+//
+//   shortcrust-modes-table DATA_DIR [FILE ...]
+//
+// FILE names a point file in DATA_DIR without its .ply extension; the
+// default is the list below. For each file and method: triangles, samples
+// used (vertices / distinct points), non-manifold edges and vertices,
+// orientation errors, boundary loops, components, closed or not, genus of
+// the closed components, the distance from the output to the ground-truth
+// mesh where there is one (RMS and maximum over the triangle centroids and
+// vertices, point to triangle, in units of the file's median sample
+// spacing), and the time beside CGAL's Delaunay triangulation of the same
+// points.
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Advancing_front_surface_reconstruction.h>
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "files.h"
+#include "shortcrust.h"
+#include "testsupport.h"
+
+namespace {
+
+typedef CGAL::Exact_predicates_inexact_constructions_kernel K;
+typedef K::Point_3 Point;
+typedef K::Triangle_3 Triangle;
+typedef std::vector<Triangle>::const_iterator TriIt;
+typedef CGAL::AABB_triangle_primitive<K, TriIt> Primitive;
+typedef CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>> Tree;
+
+double now() {
+  return std::chrono::duration<double>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+struct Reference {
+  std::vector<Triangle> tris;
+  std::unique_ptr<Tree> tree;
+};
+
+// Distance of the output (its vertices and triangle centroids) to the
+// reference mesh.
+void distance(const Reference &ref, const double *xyz, const uint32_t *t,
+              size_t nt, double &rms, double &max) {
+  double sum = 0;
+  size_t count = 0;
+  max = 0;
+  std::vector<uint8_t> seen;
+  auto add = [&](const Point &p) {
+    double d2 = ref.tree->squared_distance(p);
+    sum += d2;
+    ++count;
+    max = std::max(max, std::sqrt(d2));
+  };
+  for (size_t i = 0; i < nt; ++i) {
+    const double *a = xyz + 3 * size_t(t[3 * i]), *b = xyz + 3 * size_t(t[3 * i + 1]),
+                 *c = xyz + 3 * size_t(t[3 * i + 2]);
+    add(Point((a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3,
+              (a[2] + b[2] + c[2]) / 3));
+    for (int k = 0; k < 3; ++k) {
+      uint32_t v = t[3 * i + k];
+      if (v >= seen.size())
+        seen.resize(size_t(v) + 1, 0);
+      if (!seen[v]) {
+        seen[v] = 1;
+        add(Point(xyz[3 * size_t(v)], xyz[3 * size_t(v) + 1],
+                  xyz[3 * size_t(v) + 2]));
+      }
+    }
+  }
+  rms = count ? std::sqrt(sum / double(count)) : 0;
+}
+
+double median_spacing(const std::vector<Point> &pts) {
+  typedef CGAL::Delaunay_triangulation_3<K> Dt;
+  Dt dt(pts.begin(), pts.end());
+  std::vector<double> nn;
+  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end();
+       ++v) {
+    std::vector<Dt::Vertex_handle> adj;
+    dt.finite_adjacent_vertices(v, std::back_inserter(adj));
+    double best = HUGE_VAL;
+    for (auto w : adj)
+      best = std::min(best, CGAL::squared_distance(v->point(), w->point()));
+    nn.push_back(std::sqrt(best));
+  }
+  std::nth_element(nn.begin(), nn.begin() + nn.size() / 2, nn.end());
+  return nn.empty() ? 1 : nn[nn.size() / 2];
+}
+
+void row(const char *file, const char *method, const char *path,
+         size_t points, const uint32_t *t, size_t nt, const double *xyz,
+         const Reference *ref, double spacing, double seconds,
+         double dt_seconds) {
+  sc_meshcheck_t c;
+  if (sc_meshcheck(points, xyz, t, nt, nullptr, &c) != 0) {
+    std::printf("| %s | %s | meshcheck failed |\n", file, method);
+    return;
+  }
+  std::string genus;
+  for (size_t i = 0; i < c.component_count; ++i) {
+    if (!c.comp[i].closed)
+      continue;
+    if (genus.size() > 24) {
+      genus += ",...";
+      break;
+    }
+    genus += (genus.empty() ? "" : ",") + std::to_string(c.comp[i].genus);
+  }
+  char dist[64] = "-";
+  if (ref) {
+    double rms, max;
+    distance(*ref, xyz, t, nt, rms, max);
+    std::snprintf(dist, sizeof dist, "%.2f / %.1f", rms / spacing,
+                  max / spacing);
+  }
+  std::printf("| %s | %s | %s | %zu | %.2f%% | %llu / %llu | %llu | %llu | "
+              "%llu | %s | %s | %s | %.2f s | %.2f |\n",
+              file, method, path, nt,
+              100.0 * double(c.vertices_used) / double(points),
+              (unsigned long long)c.nonmanifold_edges,
+              (unsigned long long)c.nonmanifold_vertices,
+              (unsigned long long)c.orientation_errors,
+              (unsigned long long)c.boundary_loops,
+              (unsigned long long)c.components, c.closed ? "yes" : "no",
+              genus.empty() ? "-" : genus.c_str(), dist, seconds,
+              seconds / dt_seconds);
+  std::fflush(stdout);
+  sc_meshcheck_free(&c);
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s DATA_DIR [FILE ...]\n", argv[0]);
+    return 2;
+  }
+  const std::string dir = argv[1];
+  std::vector<std::string> files;
+  for (int i = 2; i < argc; ++i)
+    files.push_back(argv[i]);
+  if (files.empty())
+    files = {"bunny_points",         "bunny_rawscan_bun000",
+             "bunny_rawscan_bun045", "bunny_rawscans_merged10",
+             "cgal_kitten_normals",  "cgal_half"};
+  const sc_mode_t modes[] = {SC_MODE_COCONE, SC_MODE_BOUNDARY,
+                             SC_MODE_WATERTIGHT, SC_MODE_AUTO};
+  const char *const mode_names[] = {"cocone", "boundary", "watertight",
+                                    "auto"};
+
+  std::printf("| file | method | path | triangles | samples used | "
+              "non-manifold edges / vertices | orientation errors | "
+              "boundary loops | components | closed | genus (closed) | "
+              "distance to GT, RMS / max (spacings) | time | time / CGAL "
+              "Delaunay |\n");
+  std::printf("|---|---|---|--:|--:|--:|--:|--:|--:|---|---|--:|--:|--:|\n");
+  for (const std::string &name : files) {
+    char msg[512];
+    sc_points_t pts;
+    std::string path = dir + "/" + name + ".ply";
+    if (sc_points_read(path.c_str(), &pts, msg, sizeof msg) != 0) {
+      std::fprintf(stderr, "%s\n", msg);
+      return 1;
+    }
+    std::vector<Point> points;
+    points.reserve(pts.count);
+    for (size_t i = 0; i < pts.count; ++i)
+      points.emplace_back(pts.xyz[3 * i], pts.xyz[3 * i + 1],
+                          pts.xyz[3 * i + 2]);
+
+    // The yardstick: CGAL's Delaunay triangulation of the same points,
+    // inserted as a range.
+    double t0 = now();
+    {
+      CGAL::Delaunay_triangulation_3<K> dt(points.begin(), points.end());
+      if (dt.number_of_vertices() == 0)
+        return 1;
+    }
+    const double dt_seconds = now() - t0;
+    const double spacing = median_spacing(points);
+
+    // The ground truth, where there is one.
+    std::unique_ptr<Reference> ref;
+    std::string gt = name.rfind("bunny", 0) == 0 ? "bunny_gt_mesh"
+                     : name.rfind("cgal_kitten", 0) == 0 ? "kitten_gt_mesh"
+                                                          : "";
+    if (!gt.empty()) {
+      sc_points_t gp;
+      uint32_t *gt_tri = nullptr;
+      size_t gnt = 0;
+      std::string gpath = dir + "/" + gt + ".ply";
+      if (sc_mesh_read(gpath.c_str(), &gp, &gt_tri, &gnt, msg, sizeof msg) ==
+          0) {
+        ref = std::make_unique<Reference>();
+        for (size_t i = 0; i < gnt; ++i) {
+          Point p[3];
+          for (int k = 0; k < 3; ++k) {
+            const double *q = gp.xyz + 3 * size_t(gt_tri[3 * i + k]);
+            p[k] = Point(q[0], q[1], q[2]);
+          }
+          ref->tris.emplace_back(p[0], p[1], p[2]);
+        }
+        ref->tree = std::make_unique<Tree>(ref->tris.begin(), ref->tris.end());
+        ref->tree->accelerate_distance_queries();
+        std::free(gt_tri);
+        sc_points_free(&gp);
+      } else {
+        std::fprintf(stderr, "%s (no distances)\n", msg);
+      }
+    }
+
+    for (size_t m = 0; m < sizeof modes / sizeof modes[0]; ++m) {
+      sc_params_t p;
+      sc_params_init(&p);
+      p.mode = modes[m];
+      sc_mesh_t *mesh = nullptr;
+      t0 = now();
+      int rc = sc_reconstruct(pts.xyz, pts.count, &p, &mesh, msg, sizeof msg);
+      double sec = now() - t0;
+      if (rc != 0) {
+        std::printf("| %s | %s | failed: %s |\n", name.c_str(), mode_names[m],
+                    msg);
+        continue;
+      }
+      row(name.c_str(), mode_names[m], sc_path_name(mesh->diag.path),
+          pts.count, mesh->triangles, mesh->triangle_count, pts.xyz,
+          ref.get(), spacing, sec, dt_seconds);
+      sc_mesh_free(mesh);
+    }
+
+    // CGAL's advancing-front reconstruction with its defaults.
+    std::vector<std::array<std::size_t, 3>> facets;
+    t0 = now();
+    CGAL::advancing_front_surface_reconstruction(
+        points.begin(), points.end(), std::back_inserter(facets));
+    double sec = now() - t0;
+    std::vector<uint32_t> t;
+    t.reserve(3 * facets.size());
+    for (const auto &f : facets)
+      for (int k = 0; k < 3; ++k)
+        t.push_back(uint32_t(f[k]));
+    row(name.c_str(), "CGAL AFSR", "-", pts.count, t.data(), facets.size(),
+        pts.xyz, ref.get(), spacing, sec, dt_seconds);
+    sc_points_free(&pts);
+  }
+  return 0;
+}
