@@ -137,6 +137,16 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 // fills the output fields of diag (triangles, boundary, components ...).
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
               Progress &progress, Surface &out, sc_diag_t &diag);
+// Removes the closed components of fewer than min_triangles triangles
+// (bubbles between the layers of overlapping scans); s describes tris.
+void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
+                       size_t min_triangles);
+// Inserts every sample that is in no triangle into the nearest triangle
+// (splitting it in three, or the two triangles of the nearest edge in
+// two each) when it is closer to it than the triangle's longest edge.
+// Keeps the surface a consistently oriented manifold. Returns the count.
+size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
+                      Progress &progress);
 // Removes every triangle on an edge with more than two, then keeps the
 // largest fan at each vertex: what is left is a 2-manifold (with boundary).
 void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,

@@ -21,6 +21,9 @@ constexpr size_t kMaxPoints = 0xFFFFFFFEu;
 // The longest hole the watertight fallback fills: the least-area patch
 // costs the cube of the loop's length.
 constexpr size_t kMaxFillLoop = 2000;
+// Closed components of fewer triangles than this, or than a thousandth of
+// the surface, are bubbles between scan layers in the modes for scans.
+constexpr size_t kMinBubble = 8;
 
 void check_finite(const double *xyz, size_t n, size_t first) {
   for (size_t i = 0; i < 3 * n; ++i) {
@@ -230,6 +233,19 @@ sc_mesh_t *Recon::finish() {
   extract(lxyz.data(), m, f.tris, alive,
           watertight ? 0 : size_t(params_.max_hole_edges), f.boundary,
           progress, surf, diag);
+  if (detects_boundary(params_.mode)) {
+    // Real scans: overlapping layers leave bubbles, small closed components
+    // between them, and samples the walk passed by. Drop the bubbles, then
+    // insert every sample near the surface into it.
+    const size_t before = surf.tris.size() / 3;
+    drop_small_closed(surf.tris, surf,
+                      std::max<size_t>(kMinBubble, before / 1000));
+    diag.bubbles_dropped = diag.closed_components;
+    diag.samples_attached = attach_samples(lxyz.data(), m, surf.tris, progress);
+    describe(lxyz.data(), m, surf.tris, progress, surf, diag);
+    diag.bubbles_dropped -= std::min(diag.bubbles_dropped,
+                                     diag.closed_components);
+  }
   if (watertight)
     close_surface(lxyz.data(), m, progress, surf, diag);
 

@@ -178,6 +178,10 @@ typedef struct sc_diag {
   uint64_t loops_by_length[4];
   uint64_t cells_relabelled;  /* watertight: cells moved to the other label
                                  to make the surface a manifold */
+  uint64_t bubbles_dropped;   /* small closed components removed (boundary,
+                                 watertight and auto modes) */
+  uint64_t samples_attached;  /* samples left out by extraction and then
+                                 inserted into the nearest triangle */
 } sc_diag_t;
 
 /* Values of sc_diag_t.path. */

@@ -831,3 +831,246 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
 }
 
 } // namespace sc
+
+namespace sc {
+namespace {
+
+// Closest point of triangle abc to p (Ericson, Real-Time Collision
+// Detection, 5.1.5), as barycentric weights.
+void closest_on_triangle(const double *p, const double *a, const double *b,
+                         const double *c, double w[3]) {
+  double ab[3], ac[3], ap[3];
+  for (int k = 0; k < 3; ++k)
+    ab[k] = b[k] - a[k], ac[k] = c[k] - a[k], ap[k] = p[k] - a[k];
+  auto dot = [](const double *x, const double *y) {
+    return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+  };
+  double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) {
+    w[0] = 1, w[1] = 0, w[2] = 0;
+    return;
+  }
+  double bp[3], cp[3];
+  for (int k = 0; k < 3; ++k)
+    bp[k] = p[k] - b[k], cp[k] = p[k] - c[k];
+  double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) {
+    w[0] = 0, w[1] = 1, w[2] = 0;
+    return;
+  }
+  double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    double v = d1 / (d1 - d3);
+    w[0] = 1 - v, w[1] = v, w[2] = 0;
+    return;
+  }
+  double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) {
+    w[0] = 0, w[1] = 0, w[2] = 1;
+    return;
+  }
+  double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    double v = d2 / (d2 - d6);
+    w[0] = 1 - v, w[1] = 0, w[2] = v;
+    return;
+  }
+  double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    double v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    w[0] = 0, w[1] = 1 - v, w[2] = v;
+    return;
+  }
+  double den = 1 / (va + vb + vc);
+  w[1] = vb * den, w[2] = vc * den, w[0] = 1 - w[1] - w[2];
+}
+
+double dist2(const double *x, const double *y) {
+  double d[3] = {x[0] - y[0], x[1] - y[1], x[2] - y[2]};
+  return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+} // namespace
+
+void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
+                       size_t min_triangles) {
+  const size_t nt = tris.size() / 3;
+  // Components in the order describe() numbered them: by first triangle.
+  std::vector<size_t> size;
+  std::vector<int32_t> comp(nt, -1);
+  // describe() kept no per-triangle component, so recount over edges.
+  std::vector<std::pair<uint64_t, uint32_t>> edges;
+  edges.reserve(3 * nt);
+  for (size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k)
+      edges.emplace_back(edge_key(tris[3 * t + k], tris[3 * t + (k + 1) % 3]),
+                         uint32_t(t));
+  std::sort(edges.begin(), edges.end());
+  UnionFind uf(nt);
+  for (size_t i = 1; i < edges.size(); ++i)
+    if (edges[i].first == edges[i - 1].first)
+      uf.unite(edges[i].second, edges[i - 1].second);
+  std::vector<size_t> count(nt, 0);
+  for (size_t t = 0; t < nt; ++t)
+    ++count[uf.find(uint32_t(t))];
+  std::vector<uint32_t> res;
+  res.reserve(tris.size());
+  for (size_t t = 0; t < nt; ++t)
+    if (!s.in_closed[t] || count[uf.find(uint32_t(t))] >= min_triangles)
+      res.insert(res.end(), &tris[3 * t], &tris[3 * t] + 3);
+  tris.swap(res);
+}
+
+size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
+                      Progress &progress) {
+  size_t nt = tris.size() / 3;
+  if (nt == 0)
+    return 0;
+  // Stars that grow as triangles split.
+  std::vector<std::vector<uint32_t>> star(n);
+  std::vector<uint8_t> used(n, 0);
+  double edge_sum = 0;
+  for (size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      uint32_t v = tris[3 * t + k];
+      star[v].push_back(uint32_t(t));
+      used[v] = 1;
+      edge_sum += std::sqrt(dist2(xyz + 3 * size_t(v),
+                                  xyz + 3 * size_t(tris[3 * t + (k + 1) % 3])));
+    }
+  const double cell = 2 * edge_sum / double(3 * nt);
+  if (!(cell > 0))
+    return 0;
+  // A hash grid of the used vertices, cells twice the mean edge long.
+  auto key = [&](const double *p, int dx, int dy, int dz) {
+    int64_t x = int64_t(std::floor(p[0] / cell)) + dx,
+            y = int64_t(std::floor(p[1] / cell)) + dy,
+            z = int64_t(std::floor(p[2] / cell)) + dz;
+    return uint64_t(x * 73856093) ^ uint64_t(y * 19349663) ^
+           uint64_t(z * 83492791);
+  };
+  std::vector<std::pair<uint64_t, uint32_t>> grid;
+  for (uint32_t v = 0; v < n; ++v)
+    if (used[v])
+      grid.emplace_back(key(xyz + 3 * size_t(v), 0, 0, 0), v);
+  std::sort(grid.begin(), grid.end());
+
+  size_t attached = 0;
+  std::vector<uint32_t> near;
+  for (uint32_t s = 0; s < n; ++s) {
+    progress.tick(s, n);
+    if (used[s])
+      continue;
+    const double *p = xyz + 3 * size_t(s);
+    near.clear();
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          uint64_t k = key(p, dx, dy, dz);
+          auto it = std::lower_bound(
+              grid.begin(), grid.end(), std::make_pair(k, uint32_t(0)));
+          for (; it != grid.end() && it->first == k; ++it)
+            near.insert(near.end(), star[it->second].begin(),
+                        star[it->second].end());
+        }
+    // The nearest triangle, if the sample is closer to it than its longest
+    // edge (farther samples are outliers and stay out).
+    double best = std::numeric_limits<double>::infinity(), bw[3] = {0, 0, 0};
+    uint32_t bt = UINT32_MAX;
+    for (uint32_t t : near) {
+      const uint32_t *v = &tris[3 * size_t(t)];
+      const double *a = xyz + 3 * size_t(v[0]), *b = xyz + 3 * size_t(v[1]),
+                   *c = xyz + 3 * size_t(v[2]);
+      double w[3];
+      closest_on_triangle(p, a, b, c, w);
+      double q[3];
+      for (int k = 0; k < 3; ++k)
+        q[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
+      double d = dist2(p, q);
+      double longest = std::max(dist2(a, b), std::max(dist2(b, c), dist2(c, a)));
+      if (d < best && d <= longest) {
+        best = d, bt = t;
+        std::copy(w, w + 3, bw);
+      }
+    }
+    if (bt == UINT32_MAX)
+      continue;
+    // Split the triangle at the sample: into three when the closest point
+    // is inside it, else across the edge it is on (both triangles of an
+    // inner edge, the one of a boundary edge). Either way the sample gets
+    // one fan and every edge keeps its triangles: still a manifold, with
+    // the orientation of the triangles split.
+    uint32_t v[3];
+    std::copy(&tris[3 * size_t(bt)], &tris[3 * size_t(bt)] + 3, v);
+    int zero = -1;
+    for (int k = 0; k < 3; ++k)
+      if (bw[k] < 1e-9)
+        zero = zero < 0 ? k : 3; // 3: at a corner
+    auto set = [&](uint32_t t, uint32_t a, uint32_t b, uint32_t c) {
+      tris[3 * size_t(t)] = a, tris[3 * size_t(t) + 1] = b,
+                       tris[3 * size_t(t) + 2] = c;
+    };
+    auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
+      uint32_t t = uint32_t(tris.size() / 3);
+      tris.push_back(a), tris.push_back(b), tris.push_back(c);
+      star[a].push_back(t), star[b].push_back(t), star[c].push_back(t);
+      return t;
+    };
+    auto unstar = [&](uint32_t w, uint32_t t) {
+      auto &st = star[w];
+      st.erase(std::remove(st.begin(), st.end(), t), st.end());
+    };
+    if (zero < 0) {
+      set(bt, v[0], v[1], s);
+      star[s].push_back(bt);
+      unstar(v[2], bt);
+      add(v[1], v[2], s);
+      add(v[2], v[0], s);
+    } else {
+      // The edge: opposite the zero weight; at a corner, the edge of the
+      // two nonzero... the corner's edges, the one nearer the sample.
+      int k = zero;
+      if (zero == 3) {
+        int c = bw[0] > 0.5 ? 0 : bw[1] > 0.5 ? 1 : 2;
+        const double *pc = xyz + 3 * size_t(v[c]);
+        const double *n1 = xyz + 3 * size_t(v[(c + 1) % 3]),
+                     *n2 = xyz + 3 * size_t(v[(c + 2) % 3]);
+        // Keep the edge c-(c+1) (opposite c+2) or c-(c+2) (opposite c+1).
+        k = dist2(p, n1) <= dist2(p, n2) ? (c + 2) % 3 : (c + 1) % 3;
+        (void)pc;
+      }
+      uint32_t a = v[(k + 1) % 3], b = v[(k + 2) % 3], c = v[k];
+      // The other triangle on edge a-b, running b -> a.
+      uint32_t other = UINT32_MAX;
+      for (uint32_t t : star[a]) {
+        if (t == bt)
+          continue;
+        const uint32_t *u = &tris[3 * size_t(t)];
+        for (int j = 0; j < 3; ++j)
+          if (u[j] == b && u[(j + 1) % 3] == a)
+            other = t;
+      }
+      set(bt, c, a, s);
+      star[s].push_back(bt);
+      unstar(b, bt);
+      add(c, s, b);
+      if (other != UINT32_MAX) {
+        uint32_t u[3];
+        std::copy(&tris[3 * size_t(other)], &tris[3 * size_t(other)] + 3, u);
+        int j = 0;
+        while (!(u[j] == b && u[(j + 1) % 3] == a))
+          ++j;
+        uint32_t d = u[(j + 2) % 3];
+        set(other, b, s, d);
+        star[s].push_back(other);
+        unstar(a, other);
+        add(s, a, d);
+      }
+    }
+    used[s] = 1;
+    ++attached;
+  }
+  return attached;
+}
+
+} // namespace sc
