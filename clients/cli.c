@@ -266,6 +266,8 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
   U64_(boundary_samples);
   U64_(longest_loop);
   U64_(cells_relabelled);
+  U64_(bubbles_dropped);
+  U64_(samples_attached);
 #undef U64_
   fputs("  \"path\": ", f);
   json_string(f, sc_path_name(d->path));
