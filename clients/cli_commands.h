@@ -15,5 +15,10 @@ typedef struct sc_cli_command {
 } sc_cli_command_t;
 
 int sc_cmd_reconstruct(int argc, char **argv);
+#ifdef SC_HAVE_CLIENT
+int sc_cmd_submit(int argc, char **argv);
+int sc_cmd_stats(int argc, char **argv);
+int sc_cmd_ping(int argc, char **argv);
+#endif
 
 #endif /* SC_CLI_COMMANDS_H */

@@ -17,6 +17,12 @@
 static const sc_cli_command_t commands[] = {
     {"reconstruct", sc_cmd_reconstruct,
      "reconstruct a mesh from a point file, here, without a daemon"},
+#ifdef SC_HAVE_CLIENT
+    {"submit", sc_cmd_submit,
+     "the same, through the daemon (shortcrustd)"},
+    {"stats", sc_cmd_stats, "the daemon's counters"},
+    {"ping", sc_cmd_ping, "check that the daemon answers"},
+#endif
 };
 
 static void usage(FILE *f) {

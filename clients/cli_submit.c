@@ -1,0 +1,351 @@
+/*
+ * `shortcrust submit`: read a point file, have the daemon reconstruct it,
+ * write the mesh. Options, formats, summary and report are those of
+ * `shortcrust reconstruct`, and so are the triangles: the points travel as
+ * exact doubles and the daemon runs the same core with the same defaults.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "cli_commands.h"
+#include "files.h"
+#include "shortcrust_client.h"
+
+#define SC_PI 3.14159265358979323846
+
+static void usage(FILE *f) {
+  sc_params_t d;
+  sc_params_init(&d);
+  char sock[256];
+  fprintf(
+      f,
+      "usage: shortcrust submit IN -o OUT [options]\n\n"
+      "Sends the points of IN to the shortcrust daemon (shortcrustd), which\n"
+      "reconstructs the mesh, and writes the mesh to OUT. Formats, summary\n"
+      "and report are those of `shortcrust reconstruct`, and so are the\n"
+      "triangles for the same input and options. IN may be .ply (ascii or\n"
+      "binary), .xyz/.txt/.pts/.csv, .off or .obj; OUT's extension picks the\n"
+      "format: .ply (binary unless --ascii), .off, .obj or .stl. The daemon\n"
+      "fills holes, prunes and finds boundaries with the defaults of\n"
+      "`reconstruct`, on one thread.\n\n"
+      "options:\n"
+      "  -o, --output OUT      the mesh to write (required)\n"
+      "  -m, --mode MODE       cocone, shortcrust, boundary (scans with a "
+      "boundary),\n"
+      "                        watertight (close every hole) or auto "
+      "(default %s)\n"
+      "      --r R             shortcrust sampling parameter, in (0, 0.5) "
+      "(default %g)\n"
+      "      --theta DEG       cocone half-width in degrees, in (0, 90) "
+      "(default %g)\n"
+      "      --socket PATH     the daemon's socket (default %s)\n"
+      "      --report FILE     write the diagnostics as JSON to FILE\n"
+      "      --ascii           write ascii PLY or STL instead of binary\n"
+      "      --no-normals      do not write per-vertex normals\n"
+      "  -q, --quiet           no progress and no summary; errors only\n"
+      "  -h, --help            this text\n\n"
+      "Progress (upload, each stage on the daemon, download) goes to stderr\n"
+      "when it is a terminal; the summary goes to stdout. Exit status: 0\n"
+      "done, 1 failed (the message says why), 2 bad command line.\n",
+      sc_cli_mode_name(d.mode), d.r, d.cocone_theta * 180 / SC_PI,
+      sc_client_default_socket(sock, sizeof sock));
+}
+
+enum {
+  OPT_R = 256,
+  OPT_THETA,
+  OPT_SOCKET,
+  OPT_REPORT,
+  OPT_ASCII,
+  OPT_NO_NORMALS
+};
+
+static const struct option long_options[] = {
+    {"output", required_argument, NULL, 'o'},
+    {"mode", required_argument, NULL, 'm'},
+    {"r", required_argument, NULL, OPT_R},
+    {"theta", required_argument, NULL, OPT_THETA},
+    {"socket", required_argument, NULL, OPT_SOCKET},
+    {"report", required_argument, NULL, OPT_REPORT},
+    {"ascii", no_argument, NULL, OPT_ASCII},
+    {"no-normals", no_argument, NULL, OPT_NO_NORMALS},
+    {"quiet", no_argument, NULL, 'q'},
+    {"help", no_argument, NULL, 'h'},
+    {NULL, 0, NULL, 0},
+};
+
+/* The library's progress, on the command's progress line. */
+static int show_progress(void *user, sc_client_job_t *job, uint32_t stage,
+                         double fraction) {
+  sc_cli_progress_t *p = user;
+  if (stage == SC_CLIENT_STAGE_UPLOAD || stage == SC_CLIENT_STAGE_DOWNLOAD) {
+    if (p->enabled && (int)stage != p->last_stage) {
+      p->last_stage = (int)stage;
+      p->last_time = 0; /* a new step is always shown */
+    }
+    sc_cli_progress_step(p, sc_client_stage_name(stage), fraction);
+  } else if (stage < SC_STAGE_COUNT) {
+    sc_cli_progress_fn(p, (sc_stage_t)stage, fraction);
+  }
+  return 0;
+}
+
+static uint64_t value_u64(const sc_client_mesh_t *m, const char *name) {
+  const sc_client_value_t *v =
+      sc_client_value_find(m->values, m->value_count, name);
+  if (!v)
+    return 0;
+  return v->kind == SC_CLIENT_F64 ? (uint64_t)v->v.f : v->v.u;
+}
+
+static int64_t value_i64(const sc_client_mesh_t *m, const char *name) {
+  const sc_client_value_t *v =
+      sc_client_value_find(m->values, m->value_count, name);
+  if (!v)
+    return 0;
+  return v->kind == SC_CLIENT_F64 ? (int64_t)v->v.f : v->v.i;
+}
+
+/* The daemon's diagnostics (PROTOCOL.md 6.12) as the core reports them. */
+static void diag_from_values(const sc_client_mesh_t *m, sc_diag_t *d) {
+  memset(d, 0, sizeof *d);
+#define U_(field) d->field = value_u64(m, #field)
+  U_(points_in);
+  U_(duplicates_merged);
+  U_(delaunay_vertices);
+  U_(delaunay_cells);
+  U_(delaunay_facets);
+  U_(hull_vertices);
+  U_(degenerate_cells);
+  U_(candidates);
+  U_(pruned);
+  U_(triangles);
+  U_(walk_rejected);
+  U_(holes_filled);
+  U_(hole_triangles);
+  U_(samples_unused);
+  U_(boundary_edges);
+  U_(boundary_loops);
+  U_(nonmanifold_edges);
+  U_(nonmanifold_vertices);
+  U_(components);
+  U_(closed_components);
+  U_(boundary_samples);
+  U_(longest_loop);
+  U_(cells_relabelled);
+  U_(bubbles_dropped);
+  U_(samples_attached);
+#undef U_
+  d->path = (int)value_u64(m, "path");
+  d->loops_by_length[0] = value_u64(m, "loops.3_10");
+  d->loops_by_length[1] = value_u64(m, "loops.11_100");
+  d->loops_by_length[2] = value_u64(m, "loops.101_1000");
+  d->loops_by_length[3] = value_u64(m, "loops.over_1000");
+  d->closed = value_u64(m, "closed") != 0;
+  d->euler = value_i64(m, "euler");
+  d->genus = value_i64(m, "genus");
+  char name[64];
+  for (int s = 0; s < SC_STAGE_COUNT; ++s) {
+    snprintf(name, sizeof name, "seconds.%s", sc_stage_name(s));
+    d->seconds[s] = sc_client_value_get(m->values, m->value_count, name, 0);
+  }
+  d->seconds_total =
+      sc_client_value_get(m->values, m->value_count, "seconds.total", 0);
+  /* What the counts must be whatever the daemon chose to send. */
+  if (!sc_client_value_find(m->values, m->value_count, "points_in"))
+    d->points_in = m->point_count;
+  d->triangles = m->triangle_count;
+}
+
+int sc_cmd_submit(int argc, char **argv) {
+  sc_params_t params;
+  sc_params_init(&params);
+  /* The daemon's reconstruction runs on one thread. */
+  params.threads = 1;
+  const char *out_path = NULL, *report = NULL, *socket_path = NULL;
+  int quiet = 0, ascii = 0, normals = 1;
+  double v;
+
+  opterr = 0;
+  int c;
+  while ((c = getopt_long(argc, argv, ":o:m:qh", long_options, NULL)) != -1) {
+    switch (c) {
+    case 'o':
+      out_path = optarg;
+      break;
+    case 'm':
+      if (sc_cli_parse_mode("--mode", optarg, &params.mode) < 0)
+        return SC_EXIT_USAGE;
+      break;
+    case OPT_R:
+      if (sc_cli_parse_double("--r", optarg, &params.r) < 0)
+        return SC_EXIT_USAGE;
+      break;
+    case OPT_THETA:
+      if (sc_cli_parse_double("--theta", optarg, &v) < 0)
+        return SC_EXIT_USAGE;
+      params.cocone_theta = v * SC_PI / 180;
+      break;
+    case OPT_SOCKET:
+      socket_path = optarg;
+      break;
+    case OPT_REPORT:
+      report = optarg;
+      break;
+    case OPT_ASCII:
+      ascii = 1;
+      break;
+    case OPT_NO_NORMALS:
+      normals = 0;
+      break;
+    case 'q':
+      quiet = 1;
+      break;
+    case 'h':
+      usage(stdout);
+      return SC_EXIT_OK;
+    case ':':
+      sc_cli_error("submit: %s needs a value", argv[optind - 1]);
+      return SC_EXIT_USAGE;
+    default:
+      sc_cli_error("submit: unknown option '%s' (see shortcrust submit "
+                   "--help)",
+                   argv[optind - 1]);
+      return SC_EXIT_USAGE;
+    }
+  }
+  if (optind >= argc) {
+    sc_cli_error("submit: no input file (see shortcrust submit --help)");
+    return SC_EXIT_USAGE;
+  }
+  if (optind + 1 < argc) {
+    sc_cli_error("submit: one input file expected, got '%s' too",
+                 argv[optind + 1]);
+    return SC_EXIT_USAGE;
+  }
+  const char *in_path = argv[optind];
+  if (!out_path) {
+    sc_cli_error("submit: no output file: give -o OUT");
+    return SC_EXIT_USAGE;
+  }
+  /* Checked here, before any file or the daemon is touched, and worded as
+   * `reconstruct` words them. */
+  if (!(params.r > 0 && params.r < 0.5)) {
+    sc_cli_error("submit: r must be in (0, 0.5), got %g", params.r);
+    return SC_EXIT_USAGE;
+  }
+  if (!(params.cocone_theta > 0 && params.cocone_theta < SC_PI / 2)) {
+    sc_cli_error("submit: cocone_theta must be in (0, pi/2), got %g",
+                 params.cocone_theta);
+    return SC_EXIT_USAGE;
+  }
+
+  char msg[1024];
+  sc_mesh_format_t fmt;
+  if (sc_mesh_format_from_path(out_path, ascii, &fmt, msg, sizeof msg) < 0) {
+    sc_cli_error("%s", msg);
+    return SC_EXIT_USAGE;
+  }
+
+  sc_cli_progress_t progress;
+  sc_cli_progress_init(&progress, quiet);
+
+  double t0 = sc_cli_now();
+  sc_cli_progress_step(&progress, "reading", 0);
+  sc_points_t pts;
+  if (sc_points_read(in_path, &pts, msg, sizeof msg) < 0) {
+    sc_cli_progress_done(&progress);
+    sc_cli_error("%s", msg);
+    return SC_EXIT_FAILURE;
+  }
+  double t_read = sc_cli_now() - t0;
+
+  sc_client_options_t opts;
+  sc_client_options_init(&opts);
+  opts.socket_path = socket_path;
+  sc_client_t *client = NULL;
+  int rc = sc_client_connect(&opts, &client, msg, sizeof msg);
+  if (rc < 0) {
+    sc_cli_progress_done(&progress);
+    sc_points_free(&pts);
+    sc_cli_error("%s", msg);
+    return SC_EXIT_FAILURE;
+  }
+
+  sc_client_params_t cp;
+  sc_client_params_init(&cp);
+  cp.mode = (int)params.mode;
+  cp.r = params.r;
+  cp.theta = params.cocone_theta;
+  /* As doubles, so that the file gets what the local command writes. */
+  cp.normals = normals;
+  cp.progress = show_progress;
+  cp.progress_user = &progress;
+  sc_client_job_t *job = NULL;
+  rc = sc_client_submit(client, &cp, pts.xyz, pts.count, &job);
+  if (rc == 0)
+    rc = sc_client_wait(client, job, -1);
+  if (rc < 0) {
+    sc_cli_progress_done(&progress);
+    int status = SC_EXIT_FAILURE;
+    if (rc == SC_CLIENT_EINVAL) {
+      sc_cli_error("submit: %s", sc_client_last_error(client));
+      status = SC_EXIT_USAGE;
+    } else if (job) {
+      sc_cli_error("%s: %s", in_path, sc_client_job_message(job));
+    } else {
+      sc_cli_error("%s: %s", in_path, sc_client_last_error(client));
+    }
+    sc_client_job_free(job);
+    sc_client_free(client);
+    sc_points_free(&pts);
+    return status;
+  }
+
+  sc_client_mesh_t mesh;
+  sc_client_job_mesh(job, &mesh);
+  sc_diag_t diag;
+  diag_from_values(&mesh, &diag);
+
+  sc_cli_progress_step(&progress, "writing", 0);
+  t0 = sc_cli_now();
+  rc = sc_mesh_write(out_path, fmt, pts.xyz, pts.count, mesh.triangles,
+                     (size_t)mesh.triangle_count, normals ? mesh.normals : NULL,
+                     msg, sizeof msg);
+  double t_write = sc_cli_now() - t0;
+  sc_cli_progress_done(&progress);
+  int status = SC_EXIT_OK;
+  if (rc < 0) {
+    sc_cli_error("%s", msg);
+    status = SC_EXIT_FAILURE;
+  } else {
+    double transfer = mesh.seconds_upload + mesh.seconds_download;
+    sc_cli_result_t res = {
+        .command = "submit",
+        .input = in_path,
+        .output = out_path,
+        .params = params,
+        .diag = &diag,
+        .component_genus = mesh.genus,
+        .component_count = (size_t)mesh.component_count,
+        .seconds_read = t_read,
+        .seconds_write = t_write,
+        .seconds_transfer = transfer,
+    };
+    if (report && sc_cli_write_report(report, &res) < 0)
+      status = SC_EXIT_FAILURE;
+    if (!quiet)
+      sc_cli_summary(stdout, &res);
+  }
+  sc_client_job_free(job);
+  sc_client_free(client);
+  sc_points_free(&pts);
+  return status;
+}
