@@ -1,0 +1,788 @@
+/*
+ * shortcrust-load: a load generator for shortcrustd. C client threads, each
+ * with its own connection, submit their share of J jobs with K of them in
+ * flight at a time, and the tool reports throughput, latency percentiles,
+ * errors by code, the daemon's counters before and after, and (--verify)
+ * whether every mesh that came back is right.
+ *
+ * DESIGN. The main thread prepares the inputs (samples of closed test
+ * surfaces, or the points of the given files), reads the daemon's counters,
+ * starts the client threads and joins them. Inputs are read-only once the
+ * threads start. Each thread owns its client handle and its tally (jobs,
+ * points, latencies, errors by code, verification failures); the main
+ * thread reads a tally only after joining its thread. The one thing the
+ * threads share is the stop time, written before they start. No locks.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "files.h"
+#include "shortcrust_client.h"
+#include "testsupport.h"
+
+#ifndef SC_VERSION
+#define SC_VERSION "unknown"
+#endif
+
+/* Distinct samples made for --points: jobs take them in turn. */
+#define LOAD_SAMPLES 6
+/* Verification failures described on stderr; the rest are only counted. */
+#define LOAD_SHOW_FAILURES 5
+#define LOAD_MAX_CODES 32
+
+static const sc_surface_t surfaces[] = {SC_SURF_SPHERE, SC_SURF_TORUS,
+                                        SC_SURF_GENUS2};
+
+typedef struct input {
+  const char *name; /* surface name or file path */
+  int surface;      /* sc_surface_t, or -1 for a file */
+  double *xyz;
+  uint64_t n;
+} input_t;
+
+typedef struct config {
+  const char *socket_path;
+  unsigned clients;
+  uint64_t jobs; /* UINT64_MAX: bounded by the duration only */
+  unsigned in_flight;
+  double duration; /* 0: none */
+  double timeout;  /* seconds a job may take */
+  int verify;
+  int json;
+  sc_client_params_t params;
+  input_t *inputs;
+  size_t ninputs;
+  double stop_at; /* monotonic time after which no job starts */
+} config_t;
+
+typedef struct code_count {
+  char name[48];
+  uint64_t count;
+} code_count_t;
+
+/* One thread's results. */
+typedef struct tally {
+  uint64_t done, failed, points;
+  double *latency_ms;
+  size_t nlat, latcap;
+  code_count_t codes[LOAD_MAX_CODES];
+  size_t ncodes;
+  uint64_t verified, verify_failures;
+  char first_failure[LOAD_SHOW_FAILURES][512];
+  unsigned nshown;
+  char first_error[512];
+} tally_t;
+
+typedef struct worker {
+  const config_t *cfg;
+  unsigned index;
+  uint64_t share;
+  pthread_t thread;
+  tally_t t;
+} worker_t;
+
+static double now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void say(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void say(const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  fputs("shortcrust-load: ", stderr);
+  vfprintf(stderr, fmt, ap);
+  fputc('\n', stderr);
+  va_end(ap);
+}
+
+static void count_error(tally_t *t, int rc, uint32_t server_code, uint64_t jobs,
+                        const char *msg) {
+  char name[48];
+  if (server_code)
+    snprintf(name, sizeof name, "%s:%s", sc_client_err_name(rc),
+             sc_client_server_code_name(server_code));
+  else
+    snprintf(name, sizeof name, "%s", sc_client_err_name(rc));
+  t->failed += jobs;
+  if (!t->first_error[0] && msg)
+    snprintf(t->first_error, sizeof t->first_error, "%s", msg);
+  for (size_t i = 0; i < t->ncodes; i++) {
+    if (strcmp(t->codes[i].name, name) == 0) {
+      t->codes[i].count += jobs;
+      return;
+    }
+  }
+  size_t i = t->ncodes < LOAD_MAX_CODES ? t->ncodes++ : LOAD_MAX_CODES - 1;
+  snprintf(t->codes[i].name, sizeof t->codes[i].name, "%s", name);
+  t->codes[i].count += jobs;
+}
+
+static void add_latency(tally_t *t, double ms) {
+  if (t->nlat == t->latcap) {
+    size_t cap = t->latcap ? 2 * t->latcap : 256;
+    double *p = realloc(t->latency_ms, cap * sizeof *p);
+    if (!p)
+      return;
+    t->latency_ms = p;
+    t->latcap = cap;
+  }
+  t->latency_ms[t->nlat++] = ms;
+}
+
+static void verify_failed(tally_t *t, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+static void verify_failed(tally_t *t, const char *fmt, ...) {
+  t->verify_failures++;
+  if (t->nshown >= LOAD_SHOW_FAILURES)
+    return;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(t->first_failure[t->nshown++], sizeof t->first_failure[0], fmt, ap);
+  va_end(ap);
+}
+
+/* Checks a returned mesh against its own input: indices in range and a
+ * manifold always; for a surface sample, closed, outward and the surface's
+ * components and genus too. */
+static void verify(tally_t *t, const input_t *in, const sc_client_job_t *job) {
+  sc_client_mesh_t m;
+  sc_client_job_mesh(job, &m);
+  t->verified++;
+  sc_meshcheck_t mc;
+  if (sc_meshcheck((size_t)in->n, in->xyz, m.triangles,
+                   (size_t)m.triangle_count, NULL, &mc) != SC_TS_OK) {
+    verify_failed(t, "%s: the mesh checker could not run", in->name);
+    return;
+  }
+  char why[256] = "", sum[256];
+  int ok;
+  if (in->surface >= 0) {
+    ok = sc_meshcheck_expect(&mc, (sc_surface_t)in->surface, SC_EXPECT_OUTWARD,
+                             why, sizeof why);
+  } else {
+    ok = mc.out_of_range == 0 && mc.manifold;
+    if (!ok)
+      snprintf(why, sizeof why,
+               "%llu triangles with an index out of range, or not a manifold",
+               (unsigned long long)mc.out_of_range);
+  }
+  double diag_tri =
+      sc_client_value_get(m.values, m.value_count, "triangles", -1);
+  if (ok && diag_tri >= 0 && diag_tri != (double)m.triangle_count) {
+    ok = 0;
+    snprintf(why, sizeof why, "diagnostics say %.0f triangles, %llu came",
+             diag_tri, (unsigned long long)m.triangle_count);
+  }
+  if (!ok)
+    verify_failed(t, "%s (%llu points): %s; %s", in->name,
+                  (unsigned long long)in->n, why,
+                  sc_meshcheck_summary(&mc, sum, sizeof sum));
+  sc_meshcheck_free(&mc);
+}
+
+/* A job in flight on a connection. */
+typedef struct slot {
+  sc_client_job_t *job;
+  const input_t *in;
+  double t0;
+} slot_t;
+
+static sc_client_t *connect_client(const config_t *cfg, tally_t *t,
+                                   int *rc_out) {
+  sc_client_options_t o;
+  sc_client_options_init(&o);
+  o.socket_path = cfg->socket_path;
+  sc_client_t *c = NULL;
+  char msg[512];
+  *rc_out = sc_client_connect(&o, &c, msg, sizeof msg);
+  if (*rc_out < 0 && !t->first_error[0])
+    snprintf(t->first_error, sizeof t->first_error, "%s", msg);
+  return c;
+}
+
+static void *run_worker(void *arg) {
+  worker_t *w = arg;
+  const config_t *cfg = w->cfg;
+  tally_t *t = &w->t;
+  slot_t *slots = calloc(cfg->in_flight, sizeof *slots);
+  if (!slots) {
+    count_error(t, SC_CLIENT_ENOMEM, 0, 1, "out of memory");
+    return NULL;
+  }
+  uint64_t submitted = 0;
+  unsigned inflight = 0;
+  sc_client_t *c = NULL;
+  int rc;
+  for (;;) {
+    int more = submitted < w->share && now_s() < cfg->stop_at;
+    if (!c && more) {
+      c = connect_client(cfg, t, &rc);
+      if (!c) {
+        /* Nothing more can run on this thread: its jobs are errors. */
+        uint64_t left = w->share == UINT64_MAX ? 1 : w->share - submitted;
+        count_error(t, rc, 0, left, NULL);
+        break;
+      }
+    }
+    while (more && inflight < cfg->in_flight) {
+      /* Threads start at different inputs, so that they do not all send
+       * the same sample at the same moment. */
+      const input_t *in =
+          &cfg->inputs[(w->index + submitted * cfg->clients) % cfg->ninputs];
+      double t0 = now_s();
+      sc_client_job_t *job = NULL;
+      rc = sc_client_submit(c, &cfg->params, in->xyz, in->n, &job);
+      submitted++;
+      if (rc < 0) {
+        count_error(t, rc, 0, 1, sc_client_last_error(c));
+        break;
+      }
+      unsigned k = 0;
+      while (slots[k].job)
+        k++;
+      slots[k] = (slot_t){.job = job, .in = in, .t0 = t0};
+      inflight++;
+      more = submitted < w->share && now_s() < cfg->stop_at;
+    }
+    if (inflight == 0) {
+      if (c && sc_client_status(c) < 0) {
+        /* The connection died between jobs; start a new one. */
+        sc_client_free(c);
+        c = NULL;
+        continue;
+      }
+      if (!more)
+        break;
+      continue;
+    }
+    sc_client_job_t *job = NULL;
+    rc = sc_client_wait_any(c, (int)(cfg->timeout * 1000), &job);
+    if (!job) {
+      /* Nothing ended in time: every job in flight counts as timed out,
+       * and the connection goes (closing it cancels them). */
+      count_error(t, SC_CLIENT_ETIMEOUT, 0, inflight, sc_client_last_error(c));
+      sc_client_free(c);
+      c = NULL;
+      memset(slots, 0, cfg->in_flight * sizeof *slots);
+      inflight = 0;
+      continue;
+    }
+    unsigned k = 0;
+    while (k < cfg->in_flight && slots[k].job != job)
+      k++;
+    if (k == cfg->in_flight) {
+      /* Not ours: cannot happen, but must not crash the run. */
+      sc_client_job_free(job);
+      continue;
+    }
+    double ms = (now_s() - slots[k].t0) * 1e3;
+    if (rc == 0) {
+      t->done++;
+      t->points += slots[k].in->n;
+      add_latency(t, ms);
+      if (cfg->verify)
+        verify(t, slots[k].in, job);
+    } else {
+      count_error(t, rc, sc_client_job_server_code(job), 1,
+                  sc_client_job_message(job));
+    }
+    sc_client_job_free(job);
+    slots[k].job = NULL;
+    inflight--;
+  }
+  sc_client_free(c);
+  free(slots);
+  return NULL;
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : x > y;
+}
+
+/* The q-quantile of sorted values, by the nearest-rank method. */
+static double quantile(const double *v, size_t n, double q) {
+  if (n == 0)
+    return 0;
+  size_t rank = (size_t)ceil(q * (double)n);
+  if (rank < 1)
+    rank = 1;
+  if (rank > n)
+    rank = n;
+  return v[rank - 1];
+}
+
+/* The daemon's counters on a connection of their own; NULL when it does
+ * not answer. */
+static sc_client_value_t *daemon_stats(const config_t *cfg, size_t *n) {
+  sc_client_options_t o;
+  sc_client_options_init(&o);
+  o.socket_path = cfg->socket_path;
+  o.io_timeout_ms = 10000;
+  sc_client_t *c = NULL;
+  char msg[512];
+  sc_client_value_t *v = NULL;
+  *n = 0;
+  if (sc_client_connect(&o, &c, msg, sizeof msg) == 0 &&
+      sc_client_stats(c, 10000, &v, n) < 0)
+    v = NULL;
+  sc_client_free(c);
+  return v;
+}
+
+static void json_values(FILE *f, const sc_client_value_t *v, size_t n) {
+  if (!v) {
+    fputs("null", f);
+    return;
+  }
+  fputc('{', f);
+  for (size_t i = 0; i < n; i++) {
+    fprintf(f, "%s\"%s\": ", i ? ", " : "", v[i].name);
+    if (v[i].kind == SC_CLIENT_U64)
+      fprintf(f, "%llu", (unsigned long long)v[i].v.u);
+    else if (v[i].kind == SC_CLIENT_I64)
+      fprintf(f, "%lld", (long long)v[i].v.i);
+    else if (v[i].kind == SC_CLIENT_F64 && isfinite(v[i].v.f))
+      fprintf(f, "%.17g", v[i].v.f);
+    else
+      fputs("null", f);
+  }
+  fputc('}', f);
+}
+
+static void json_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *p = (const unsigned char *)s; *p; ++p) {
+    if (*p == '"' || *p == '\\')
+      fprintf(f, "\\%c", *p);
+    else if (*p < 0x20)
+      fprintf(f, "\\u%04x", *p);
+    else
+      fputc(*p, f);
+  }
+  fputc('"', f);
+}
+
+static void usage(FILE *f) {
+  char sock[256];
+  fprintf(
+      f,
+      "usage: shortcrust-load [--socket PATH] --clients C --jobs J\n"
+      "                       (--points N | --files F...) [--jobs-in-flight "
+      "K]\n"
+      "                       [--duration S] [--verify] [--json]\n\n"
+      "Puts load on a running shortcrustd: C client threads, each with its\n"
+      "own connection, submit their share of J jobs, K in flight at a time\n"
+      "on each connection. The points are samples of N points of closed test\n"
+      "surfaces (sphere, torus, genus 2; %d distinct samples, used in turn)\n"
+      "or the points of the given files, used in turn. Prints throughput,\n"
+      "latency (from submit to the end of the job), errors by code and the\n"
+      "daemon's counters before and after.\n\n"
+      "options:\n"
+      "      --socket PATH       the daemon's socket (default %s)\n"
+      "  -c, --clients C         connections, one thread each (default 1)\n"
+      "  -n, --jobs J            jobs in all; optional with --duration\n"
+      "  -p, --points N          points per generated sample, at least 100\n"
+      "  -f, --files F...        point files (every input format of "
+      "`shortcrust\n"
+      "                          reconstruct`); the arguments after the "
+      "options are\n"
+      "                          files too\n"
+      "  -k, --jobs-in-flight K  jobs in flight per connection (default 1)\n"
+      "  -d, --duration S        start no job after S seconds\n"
+      "      --timeout S         a job taking longer fails (default 300)\n"
+      "      --mode MODE         cocone or shortcrust (default cocone)\n"
+      "      --r R               shortcrust parameter (default 0.18)\n"
+      "      --verify            check every mesh: indices in range and a\n"
+      "                          manifold; closed, outward and of the right\n"
+      "                          genus for the generated samples\n"
+      "      --json              also print one JSON object, on the last "
+      "line\n"
+      "  -h, --help              this text\n"
+      "  -V, --version           the version\n\n"
+      "Exit status: 0 every job done (and verified), 1 errors or "
+      "verification\nfailures, 2 bad command line.\n",
+      LOAD_SAMPLES, sc_client_default_socket(sock, sizeof sock));
+}
+
+static int parse_u64(const char *opt, const char *arg, uint64_t min,
+                     uint64_t max, uint64_t *out) {
+  char *end;
+  errno = 0;
+  unsigned long long v = strtoull(arg, &end, 10);
+  if (!*arg || *arg == '-' || *end || errno || v < min || v > max) {
+    say("%s: '%s' is not an integer in [%llu, %llu]", opt, arg,
+        (unsigned long long)min, (unsigned long long)max);
+    return -1;
+  }
+  *out = v;
+  return 0;
+}
+
+static int parse_seconds(const char *opt, const char *arg, double *out) {
+  char *end;
+  errno = 0;
+  double v = strtod(arg, &end);
+  if (end == arg || *end || errno || !isfinite(v) || v <= 0) {
+    say("%s: '%s' is not a positive number of seconds", opt, arg);
+    return -1;
+  }
+  *out = v;
+  return 0;
+}
+
+enum { OPT_SOCKET = 256, OPT_TIMEOUT, OPT_MODE, OPT_R, OPT_VERIFY, OPT_JSON };
+
+static const struct option long_options[] = {
+    {"socket", required_argument, NULL, OPT_SOCKET},
+    {"clients", required_argument, NULL, 'c'},
+    {"jobs", required_argument, NULL, 'n'},
+    {"points", required_argument, NULL, 'p'},
+    {"files", required_argument, NULL, 'f'},
+    {"jobs-in-flight", required_argument, NULL, 'k'},
+    {"duration", required_argument, NULL, 'd'},
+    {"timeout", required_argument, NULL, OPT_TIMEOUT},
+    {"mode", required_argument, NULL, OPT_MODE},
+    {"r", required_argument, NULL, OPT_R},
+    {"verify", no_argument, NULL, OPT_VERIFY},
+    {"json", no_argument, NULL, OPT_JSON},
+    {"help", no_argument, NULL, 'h'},
+    {"version", no_argument, NULL, 'V'},
+    {NULL, 0, NULL, 0},
+};
+
+int main(int argc, char **argv) {
+  config_t cfg;
+  memset(&cfg, 0, sizeof cfg);
+  cfg.clients = 1;
+  cfg.in_flight = 1;
+  cfg.jobs = 0;
+  cfg.timeout = 300;
+  sc_client_params_init(&cfg.params);
+  uint64_t points = 0, v;
+  const char **files = calloc((size_t)argc + 1, sizeof *files);
+  size_t nfiles = 0;
+  if (!files)
+    return 1;
+
+  opterr = 0;
+  int c;
+  while ((c = getopt_long(argc, argv, ":c:n:p:f:k:d:hV", long_options, NULL)) !=
+         -1) {
+    switch (c) {
+    case OPT_SOCKET:
+      cfg.socket_path = optarg;
+      break;
+    case 'c':
+      if (parse_u64("--clients", optarg, 1, 1000, &v) < 0)
+        return 2;
+      cfg.clients = (unsigned)v;
+      break;
+    case 'n':
+      if (parse_u64("--jobs", optarg, 1, UINT64_MAX - 1, &v) < 0)
+        return 2;
+      cfg.jobs = v;
+      break;
+    case 'p':
+      if (parse_u64("--points", optarg, 100, 100000000, &points) < 0)
+        return 2;
+      break;
+    case 'f':
+      files[nfiles++] = optarg;
+      break;
+    case 'k':
+      if (parse_u64("--jobs-in-flight", optarg, 1, 100000, &v) < 0)
+        return 2;
+      cfg.in_flight = (unsigned)v;
+      break;
+    case 'd':
+      if (parse_seconds("--duration", optarg, &cfg.duration) < 0)
+        return 2;
+      break;
+    case OPT_TIMEOUT:
+      if (parse_seconds("--timeout", optarg, &cfg.timeout) < 0)
+        return 2;
+      if (cfg.timeout > 2e6)
+        cfg.timeout = 2e6;
+      break;
+    case OPT_MODE:
+      if (strcmp(optarg, "cocone") == 0) {
+        cfg.params.mode = SC_CLIENT_MODE_COCONE;
+      } else if (strcmp(optarg, "shortcrust") == 0) {
+        cfg.params.mode = SC_CLIENT_MODE_SHORTCRUST;
+      } else {
+        say("--mode: unknown mode '%s' (expected cocone or shortcrust)",
+            optarg);
+        return 2;
+      }
+      break;
+    case OPT_R: {
+      char *end;
+      cfg.params.r = strtod(optarg, &end);
+      if (end == optarg || *end || !(cfg.params.r > 0 && cfg.params.r < 0.5)) {
+        say("--r: '%s' is not a number in (0, 0.5)", optarg);
+        return 2;
+      }
+      break;
+    }
+    case OPT_VERIFY:
+      cfg.verify = 1;
+      break;
+    case OPT_JSON:
+      cfg.json = 1;
+      break;
+    case 'h':
+      usage(stdout);
+      return 0;
+    case 'V':
+      printf("shortcrust-load %s\n", SC_VERSION);
+      return 0;
+    case ':':
+      say("%s needs a value", argv[optind - 1]);
+      return 2;
+    default:
+      say("unknown option '%s' (see shortcrust-load --help)", argv[optind - 1]);
+      return 2;
+    }
+  }
+  if (optind < argc && nfiles == 0) {
+    say("unexpected argument '%s'; files go after --files", argv[optind]);
+    return 2;
+  }
+  while (optind < argc)
+    files[nfiles++] = argv[optind++];
+  if ((points == 0) == (nfiles == 0)) {
+    say("give either --points N or --files F... (see shortcrust-load --help)");
+    return 2;
+  }
+  if (cfg.jobs == 0 && cfg.duration == 0) {
+    say("give --jobs J, --duration S or both");
+    return 2;
+  }
+  if (cfg.jobs == 0)
+    cfg.jobs = UINT64_MAX;
+
+  /* A daemon that goes away must show as an error, not kill the run. */
+  signal(SIGPIPE, SIG_IGN);
+
+  if (points) {
+    cfg.ninputs = LOAD_SAMPLES;
+    cfg.inputs = calloc(cfg.ninputs, sizeof *cfg.inputs);
+    for (size_t i = 0; cfg.inputs && i < cfg.ninputs; i++) {
+      input_t *in = &cfg.inputs[i];
+      in->surface = surfaces[i % (sizeof surfaces / sizeof surfaces[0])];
+      in->name = sc_surface_name((sc_surface_t)in->surface);
+      in->n = points;
+      in->xyz = malloc((size_t)points * 3 * sizeof(double));
+      if (!in->xyz ||
+          sc_sample_surface((sc_surface_t)in->surface, SC_DENSITY_UNIFORM,
+                            (size_t)points, 1000 + i, in->xyz) != SC_TS_OK) {
+        say("cannot make a sample of %llu points", (unsigned long long)points);
+        return 1;
+      }
+    }
+  } else {
+    cfg.ninputs = nfiles;
+    cfg.inputs = calloc(cfg.ninputs, sizeof *cfg.inputs);
+    for (size_t i = 0; cfg.inputs && i < nfiles; i++) {
+      input_t *in = &cfg.inputs[i];
+      sc_points_t pts;
+      char msg[1024];
+      if (sc_points_read(files[i], &pts, msg, sizeof msg) < 0) {
+        say("%s", msg);
+        return 1;
+      }
+      in->name = files[i];
+      in->surface = -1;
+      in->xyz = pts.xyz;
+      in->n = pts.count;
+    }
+  }
+  if (!cfg.inputs) {
+    say("out of memory");
+    return 1;
+  }
+
+  char sock[256];
+  const char *where = cfg.socket_path
+                          ? cfg.socket_path
+                          : sc_client_default_socket(sock, sizeof sock);
+  size_t nbefore = 0, nafter = 0;
+  sc_client_value_t *before = daemon_stats(&cfg, &nbefore);
+
+  worker_t *w = calloc(cfg.clients, sizeof *w);
+  if (!w) {
+    say("out of memory");
+    return 1;
+  }
+  double t_start = now_s();
+  cfg.stop_at = cfg.duration > 0 ? t_start + cfg.duration : INFINITY;
+  unsigned started = 0;
+  for (unsigned i = 0; i < cfg.clients; i++) {
+    w[i].cfg = &cfg;
+    w[i].index = i;
+    if (cfg.jobs == UINT64_MAX)
+      w[i].share = UINT64_MAX;
+    else
+      w[i].share = cfg.jobs / cfg.clients + (i < cfg.jobs % cfg.clients);
+    if (pthread_create(&w[i].thread, NULL, run_worker, &w[i]) != 0) {
+      say("cannot start thread %u: %s", i, strerror(errno));
+      break;
+    }
+    started++;
+  }
+  for (unsigned i = 0; i < started; i++)
+    pthread_join(w[i].thread, NULL);
+  double seconds = now_s() - t_start;
+  sc_client_value_t *after = daemon_stats(&cfg, &nafter);
+
+  /* The threads' tallies, together. */
+  tally_t all;
+  memset(&all, 0, sizeof all);
+  for (unsigned i = 0; i < started; i++) {
+    tally_t *t = &w[i].t;
+    all.done += t->done;
+    all.points += t->points;
+    all.verified += t->verified;
+    all.verify_failures += t->verify_failures;
+    for (size_t k = 0; k < t->nlat; k++)
+      add_latency(&all, t->latency_ms[k]);
+    for (size_t k = 0; k < t->ncodes; k++) {
+      size_t j = 0;
+      while (j < all.ncodes && strcmp(all.codes[j].name, t->codes[k].name))
+        j++;
+      if (j == all.ncodes && all.ncodes < LOAD_MAX_CODES)
+        snprintf(all.codes[all.ncodes++].name, sizeof all.codes[0].name, "%s",
+                 t->codes[k].name);
+      if (j < LOAD_MAX_CODES)
+        all.codes[j].count += t->codes[k].count;
+    }
+    all.failed += t->failed;
+    if (!all.first_error[0] && t->first_error[0])
+      snprintf(all.first_error, sizeof all.first_error, "%s", t->first_error);
+    for (unsigned k = 0; k < t->nshown && all.nshown < LOAD_SHOW_FAILURES; k++)
+      snprintf(all.first_failure[all.nshown++], sizeof all.first_failure[0],
+               "%s", t->first_failure[k]);
+  }
+  if (all.nlat)
+    qsort(all.latency_ms, all.nlat, sizeof(double), cmp_double);
+  double p50 = quantile(all.latency_ms, all.nlat, 0.50);
+  double p90 = quantile(all.latency_ms, all.nlat, 0.90);
+  double p99 = quantile(all.latency_ms, all.nlat, 0.99);
+  double pmax = all.nlat ? all.latency_ms[all.nlat - 1] : 0;
+  double jobs_per_s = seconds > 0 ? (double)all.done / seconds : 0;
+  double points_per_s = seconds > 0 ? (double)all.points / seconds : 0;
+  uint64_t ended = all.done + all.failed;
+
+  printf("shortcrust-load: %u client%s, %llu job%s", cfg.clients,
+         cfg.clients == 1 ? "" : "s", (unsigned long long)ended,
+         ended == 1 ? "" : "s");
+  if (points)
+    printf(" of %llu points", (unsigned long long)points);
+  else
+    printf(" from %zu file%s", nfiles, nfiles == 1 ? "" : "s");
+  printf(", %u in flight per client, on %s\n", cfg.in_flight, where);
+  printf("jobs        %llu done, %llu failed, in %.2f s\n",
+         (unsigned long long)all.done, (unsigned long long)all.failed, seconds);
+  printf("throughput  %.2f jobs/s, %.0f points/s\n", jobs_per_s, points_per_s);
+  printf("latency     p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms\n",
+         p50, p90, p99, pmax);
+  printf("errors      ");
+  if (all.ncodes == 0)
+    printf("none\n");
+  for (size_t k = 0; k < all.ncodes; k++)
+    printf("%s%s %llu%s", k ? ", " : "", all.codes[k].name,
+           (unsigned long long)all.codes[k].count,
+           k + 1 == all.ncodes ? "\n" : "");
+  if (all.first_error[0])
+    printf("            first: %s\n", all.first_error);
+  if (cfg.verify) {
+    printf("verify      %llu mesh%s checked, %llu failure%s\n",
+           (unsigned long long)all.verified, all.verified == 1 ? "" : "es",
+           (unsigned long long)all.verify_failures,
+           all.verify_failures == 1 ? "" : "s");
+    for (unsigned k = 0; k < all.nshown; k++)
+      printf("            %s\n", all.first_failure[k]);
+  }
+  static const char *const shown[] = {
+      "jobs_accepted_total",   "jobs_refused_total",       "jobs_done_total",
+      "jobs_failed_total",     "jobs_cancelled_total",     "points_in_total",
+      "triangles_out_total",   "bytes_in_total",           "bytes_out_total",
+      "protocol_errors_total", "slow_readers_closed_total"};
+  if (before && after) {
+    printf("daemon      ");
+    const char *sep = "";
+    for (size_t k = 0; k < sizeof shown / sizeof shown[0]; k++) {
+      const sc_client_value_t *a =
+          sc_client_value_find(before, nbefore, shown[k]);
+      const sc_client_value_t *b =
+          sc_client_value_find(after, nafter, shown[k]);
+      if (!a || !b || a->kind != SC_CLIENT_U64 || b->kind != SC_CLIENT_U64)
+        continue;
+      printf("%s%s +%llu", sep, shown[k],
+             (unsigned long long)(b->v.u - a->v.u));
+      sep = ", ";
+    }
+    printf("\n");
+  } else {
+    printf("daemon      counters unavailable (%s)\n",
+           before ? "after the run" : "before the run");
+  }
+  if (cfg.json) {
+    printf("{\"clients\": %u, \"jobs_in_flight\": %u, ", cfg.clients,
+           cfg.in_flight);
+    if (points)
+      printf("\"points\": %llu, ", (unsigned long long)points);
+    else
+      printf("\"files\": %zu, ", nfiles);
+    printf("\"jobs\": %llu, \"jobs_done\": %llu, \"errors\": %llu, "
+           "\"errors_by_code\": {",
+           (unsigned long long)ended, (unsigned long long)all.done,
+           (unsigned long long)all.failed);
+    for (size_t k = 0; k < all.ncodes; k++) {
+      printf("%s", k ? ", " : "");
+      json_string(stdout, all.codes[k].name);
+      printf(": %llu", (unsigned long long)all.codes[k].count);
+    }
+    printf("}, \"verify\": %s, \"verified\": %llu, \"verify_failures\": %llu, "
+           "\"seconds\": %.6f, \"jobs_per_s\": %.6f, \"points_per_s\": %.3f, "
+           "\"latency_p50_ms\": %.3f, \"latency_p90_ms\": %.3f, "
+           "\"latency_p99_ms\": %.3f, \"latency_max_ms\": %.3f, "
+           "\"daemon_before\": ",
+           cfg.verify ? "true" : "false", (unsigned long long)all.verified,
+           (unsigned long long)all.verify_failures, seconds, jobs_per_s,
+           points_per_s, p50, p90, p99, pmax);
+    json_values(stdout, before, nbefore);
+    printf(", \"daemon_after\": ");
+    json_values(stdout, after, nafter);
+    printf("}\n");
+  }
+
+  for (unsigned i = 0; i < cfg.clients; i++)
+    free(w[i].t.latency_ms);
+  free(w);
+  free(all.latency_ms);
+  free(before);
+  free(after);
+  for (size_t i = 0; i < cfg.ninputs; i++)
+    free(cfg.inputs[i].xyz);
+  free(cfg.inputs);
+  free(files);
+  return all.failed == 0 && all.verify_failures == 0 && started == cfg.clients
+             ? 0
+             : 1;
+}
