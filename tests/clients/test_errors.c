@@ -1,0 +1,314 @@
+/*
+ * Every way a job or a connection can fail, against the real daemon, each
+ * with its code and a message that says why: no daemon, jobs refused
+ * (too many points, no memory budget, too many jobs in use), jobs that
+ * fail (degenerate or non-finite input), parameters out of range, and the
+ * daemon dying in the middle of a job.
+ *
+ *   test_clients_errors DAEMON
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <math.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include "common.h"
+
+#define CHECK_MSG(text, part)                                                  \
+  CHECK(strstr((text), (part)) != NULL, "message '%s' lacks '%s'", (text),     \
+        (part))
+
+static int try_connect(const char *sock, char *msg, size_t len,
+                       sc_client_t **out) {
+  sc_client_options_t o;
+  sc_client_options_init(&o);
+  o.socket_path = sock;
+  o.io_timeout_ms = 5000;
+  return sc_client_connect(&o, out, msg, len);
+}
+
+static void no_daemon(void) {
+  scdt_daemon_t d;
+  REQUIRE(scdt_daemon_prepare(&d) == 0, "temporary directory");
+  char msg[512];
+  static char junk;
+  sc_client_t *c = (sc_client_t *)(void *)&junk;
+  /* No socket file at all. */
+  int rc = try_connect(d.sock, msg, sizeof msg, &c);
+  CHECK_EQ(rc, SC_CLIENT_ENODAEMON);
+  CHECK(c == NULL, "a handle came back");
+  CHECK_MSG(msg, "not running");
+  CHECK_MSG(msg, d.sock);
+  /* A socket file left behind by a daemon that is gone. */
+  int fd = socket(AF_UNIX, SOCK_STREAM, 0);
+  struct sockaddr_un sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sun_family = AF_UNIX;
+  REQUIRE(strlen(d.sock) < sizeof sa.sun_path, "path too long: %s", d.sock);
+  memcpy(sa.sun_path, d.sock, strlen(d.sock) + 1);
+  REQUIRE(fd >= 0 && bind(fd, (struct sockaddr *)&sa, sizeof sa) == 0,
+          "bind %s", d.sock);
+  close(fd);
+  rc = try_connect(d.sock, msg, sizeof msg, &c);
+  CHECK_EQ(rc, SC_CLIENT_ENODAEMON);
+  CHECK_MSG(msg, "not running");
+  unlink(d.sock);
+  /* A path no socket can have. */
+  char longpath[300];
+  memset(longpath, 'x', sizeof longpath - 1);
+  longpath[0] = '/';
+  longpath[sizeof longpath - 1] = '\0';
+  rc = try_connect(longpath, msg, sizeof msg, &c);
+  CHECK_EQ(rc, SC_CLIENT_ECONNECT);
+  CHECK_MSG(msg, "too long");
+  /* Names and messages for every code. */
+  CHECK(strcmp(sc_client_err_name(SC_CLIENT_ENODAEMON), "NODAEMON") == 0, "%s",
+        sc_client_err_name(SC_CLIENT_ENODAEMON));
+  CHECK(strcmp(sc_client_strerror(SC_CLIENT_ENODAEMON),
+               "the daemon is not running") == 0,
+        "%s", sc_client_strerror(SC_CLIENT_ENODAEMON));
+  CHECK(strcmp(sc_client_err_name(-1), "UNKNOWN") == 0, "unknown code");
+  CHECK(strcmp(sc_client_server_code_name(15), "DEGENERATE_INPUT") == 0, "%s",
+        sc_client_server_code_name(15));
+}
+
+typedef struct busy {
+  sc_client_t *c;
+  const double *xyz;
+  int calls, rc;
+  uint32_t server_code;
+  char msg[1200];
+} busy_t;
+
+/* Submits a job on another connection while the first one's upload is
+ * still open. */
+static int submit_second(void *user, sc_client_job_t *job, uint32_t stage,
+                         double fraction) {
+  busy_t *b = user;
+  if (stage != SC_CLIENT_STAGE_UPLOAD || b->calls++)
+    return 0;
+  sc_client_job_t *j;
+  b->rc = sc_client_submit(b->c, NULL, b->xyz, 900, &j);
+  if (b->rc == 0) {
+    b->rc = sc_client_wait(b->c, j, SCCT_WAIT_MS);
+    b->server_code = sc_client_job_server_code(j);
+    snprintf(b->msg, sizeof b->msg, "%s", sc_client_job_message(j));
+    sc_client_job_free(j);
+  }
+  return 0;
+}
+
+static void refused(void) {
+  /* At most 1000 points per job, 2 jobs per connection. */
+  scdt_daemon_t d;
+  const char *args[] = {"--max-points", "1000", "--max-jobs", "2", NULL};
+  REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
+  sc_client_t *c = scct_open(d.sock, 0);
+  sc_client_info_t info;
+  sc_client_get_info(c, &info);
+  CHECK_EQ(info.max_points, 1000);
+  CHECK_EQ(info.max_jobs, 2);
+  const uint64_t n = 3000;
+  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 1);
+  sc_client_job_t *j;
+  /* Too many points: refused, and why. */
+  CHECK_EQ(sc_client_submit(c, NULL, xyz, n, &j), 0);
+  CHECK_STATUS(j, SC_CLIENT_EREFUSED);
+  CHECK_EQ(sc_client_job_server_code(j), 8 /* LIMIT */);
+  CHECK_MSG(sc_client_job_message(j), "LIMIT");
+  CHECK_MSG(sc_client_job_message(j), "at most 1000");
+  CHECK_EQ(sc_client_wait(c, j, 0), SC_CLIENT_EREFUSED);
+  sc_client_job_free(j);
+  /* The connection is fine, and a job of the right size goes through. */
+  CHECK_EQ(sc_client_submit(c, NULL, xyz, 1000, &j), 0);
+  CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), 0);
+  sc_client_job_free(j);
+
+  /* Two jobs in use at once at most: the third is refused here. */
+  sc_client_job_t *a, *b;
+  CHECK_EQ(sc_client_submit(c, NULL, xyz, 1000, &a), 0);
+  CHECK_EQ(sc_client_submit(c, NULL, xyz + 3000, 1000, &b), 0);
+  int rc = sc_client_submit(c, NULL, xyz, 1000, &j);
+  CHECK_EQ(rc, SC_CLIENT_ELIMIT);
+  CHECK(j == NULL, "a job came back");
+  CHECK_MSG(sc_client_last_error(c), "wait for one");
+  CHECK_EQ(sc_client_wait(c, a, SCCT_WAIT_MS), 0);
+  CHECK_EQ(sc_client_submit(c, NULL, xyz, 1000, &j), 0);
+  CHECK_EQ(sc_client_wait(c, b, SCCT_WAIT_MS), 0);
+  CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), 0);
+  sc_client_job_free(a);
+  sc_client_job_free(b);
+  sc_client_job_free(j);
+  sc_client_free(c);
+  CHECK_EQ(scdt_daemon_stop(&d), 0);
+
+  /* A memory budget for one job of about 950 points at a time: while one
+   * job holds it, the daemon refuses another, BUSY. The second job goes
+   * out on a second connection from the first one's upload callback, when
+   * the first has sent its points but not its JOB_END. */
+  const char *args2[] = {"--memory-budget", "2M", NULL};
+  REQUIRE(scdt_daemon_start(&d, args2) == 0, "daemon did not start");
+  busy_t b2;
+  memset(&b2, 0, sizeof b2);
+  b2.c = scct_open(d.sock, 0);
+  b2.xyz = xyz;
+  c = scct_open(d.sock, 0);
+  sc_client_params_t p;
+  sc_client_params_init(&p);
+  p.progress = submit_second;
+  p.progress_user = &b2;
+  CHECK_EQ(sc_client_submit(c, &p, xyz, 900, &j), 0);
+  CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), 0);
+  sc_client_job_free(j);
+  CHECK_EQ(b2.rc, SC_CLIENT_EREFUSED);
+  CHECK_EQ(b2.server_code, 10 /* BUSY */);
+  CHECK_MSG(b2.msg, "BUSY");
+  CHECK_MSG(b2.msg, "memory budget");
+  /* Once the first job is over, there is room again. */
+  CHECK_EQ(sc_client_submit(b2.c, NULL, xyz, 900, &j), 0);
+  CHECK_EQ(sc_client_wait(b2.c, j, SCCT_WAIT_MS), 0);
+  sc_client_job_free(j);
+  sc_client_free(b2.c);
+  sc_client_free(c);
+  CHECK_EQ(scdt_daemon_stop(&d), 0);
+  free(xyz);
+}
+
+static void failed_and_invalid(void) {
+  scdt_daemon_t d;
+  REQUIRE(scdt_daemon_start(&d, NULL) == 0, "daemon did not start");
+  sc_client_t *c = scct_open(d.sock, 0);
+  sc_client_job_t *j;
+
+  /* Points all in one plane: the daemon accepts the job and fails it. */
+  double flat[3 * 100];
+  for (int i = 0; i < 100; i++) {
+    flat[3 * i] = i % 10;
+    flat[3 * i + 1] = i / 10;
+    flat[3 * i + 2] = 0;
+  }
+  CHECK_EQ(sc_client_submit(c, NULL, flat, 100, &j), 0);
+  CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), SC_CLIENT_EFAILED);
+  CHECK_EQ(sc_client_job_server_code(j), 15 /* DEGENERATE_INPUT */);
+  CHECK_MSG(sc_client_job_message(j), "DEGENERATE_INPUT");
+  CHECK_MSG(sc_client_job_message(j), "coplanar");
+  sc_client_job_free(j);
+
+  /* A NaN. */
+  double *xyz = scdt_sample(SC_SURF_SPHERE, 500, 2);
+  xyz[3 * 17 + 1] = NAN;
+  CHECK_EQ(sc_client_submit(c, NULL, xyz, 500, &j), 0);
+  CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), SC_CLIENT_EFAILED);
+  CHECK_EQ(sc_client_job_server_code(j), 16 /* NONFINITE */);
+  CHECK_MSG(sc_client_job_message(j), "NONFINITE");
+  sc_client_job_free(j);
+  free(xyz);
+
+  /* Parameters out of range never leave the client. */
+  sc_client_params_t p;
+  sc_client_params_init(&p);
+  p.r = 0.7;
+  CHECK_EQ(sc_client_submit(c, &p, flat, 100, &j), SC_CLIENT_EINVAL);
+  CHECK_MSG(sc_client_last_error(c), "r must be in (0, 0.5)");
+  sc_client_params_init(&p);
+  p.theta = 2;
+  CHECK_EQ(sc_client_submit(c, &p, flat, 100, &j), SC_CLIENT_EINVAL);
+  CHECK_MSG(sc_client_last_error(c), "theta");
+  sc_client_params_init(&p);
+  p.mode = 9;
+  CHECK_EQ(sc_client_submit(c, &p, flat, 100, &j), SC_CLIENT_EINVAL);
+  CHECK_EQ(sc_client_submit(c, NULL, NULL, 100, &j), SC_CLIENT_EINVAL);
+  CHECK_EQ(sc_client_jobs_in_use(c), 0);
+  CHECK_EQ(sc_client_ping(c, SCCT_WAIT_MS, NULL), 0);
+  sc_client_free(c);
+  CHECK_EQ(scdt_daemon_stop(&d), 0);
+}
+
+/* Kills the daemon as soon as it reports progress on the job. */
+static int kill_daemon(void *user, sc_client_job_t *job, uint32_t stage,
+                       double fraction) {
+  scdt_daemon_t *d = user;
+  if (stage < 6 && d->pid > 0)
+    kill(d->pid, SIGKILL);
+  return 0;
+}
+
+static void connection_lost(void) {
+  scdt_daemon_t d;
+  REQUIRE(scdt_daemon_start(&d, NULL) == 0, "daemon did not start");
+  sc_client_t *c = scct_open(d.sock, 0);
+  const uint64_t n = 50000;
+  double *xyz = scdt_sample(SC_SURF_TORUS, n, 4);
+  sc_client_params_t p;
+  sc_client_params_init(&p);
+  p.progress = kill_daemon;
+  p.progress_user = &d;
+  sc_client_job_t *j, *k;
+  CHECK_EQ(sc_client_submit(c, &p, xyz, n, &j), 0);
+  /* A second job, whose end is the same. */
+  CHECK_EQ(sc_client_submit(c, NULL, xyz, 1000, &k), 0);
+  CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), SC_CLIENT_ELOST);
+  CHECK_MSG(sc_client_job_message(j), "closed the connection");
+  CHECK_EQ(sc_client_wait(c, k, SCCT_WAIT_MS), SC_CLIENT_ELOST);
+  CHECK_EQ(sc_client_status(c), SC_CLIENT_ELOST);
+  CHECK_EQ(sc_client_jobs_in_use(c), 0);
+  /* Every later call says so. */
+  sc_client_job_t *l = NULL;
+  CHECK_EQ(sc_client_submit(c, NULL, xyz, 1000, &l), SC_CLIENT_ELOST);
+  CHECK(l == NULL, "a job on a dead connection");
+  CHECK_EQ(sc_client_ping(c, 1000, NULL), SC_CLIENT_ELOST);
+  CHECK_MSG(sc_client_last_error(c), "closed the connection");
+  sc_client_job_free(j);
+  sc_client_job_free(k);
+  sc_client_free(c);
+  scdt_daemon_wait(&d, 60000);
+  CHECK(d.status == 128 + SIGKILL, "daemon status %d", d.status);
+  free(xyz);
+}
+
+/* A daemon that stops gracefully with a job in flight: the job either
+ * finishes in the grace period or ends with SHUTDOWN, and then the daemon
+ * closes the connection, saying why. */
+static void shutdown_(void) {
+  scdt_daemon_t d;
+  const char *args[] = {"--grace", "0", NULL};
+  REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
+  sc_client_t *c = scct_open(d.sock, 0);
+  const uint64_t n = 200000;
+  double *xyz = malloc(n * 3 * sizeof(double));
+  REQUIRE(xyz && sc_sample_surface(SC_SURF_SPHERE, SC_DENSITY_UNIFORM_RANDOM, n,
+                                   9, xyz) == SC_TS_OK,
+          "sample");
+  sc_client_job_t *j;
+  CHECK_EQ(sc_client_submit(c, NULL, xyz, n, &j), 0);
+  kill(d.pid, SIGTERM);
+  int rc = sc_client_wait(c, j, SCCT_WAIT_MS);
+  CHECK(rc == 0 || rc == SC_CLIENT_ESHUTDOWN, "job ended with %s: %s",
+        sc_client_err_name(rc), sc_client_job_message(j));
+  sc_client_job_free(j);
+  /* Once its jobs are over the daemon closes the connection with a fatal
+   * ERROR SHUTDOWN. */
+  rc = sc_client_ping(c, SCCT_WAIT_MS, NULL);
+  CHECK(rc == SC_CLIENT_ESHUTDOWN || rc == SC_CLIENT_ELOST,
+        "ping after shutdown: %s: %s", sc_client_err_name(rc),
+        sc_client_last_error(c));
+  sc_client_free(c);
+  CHECK_EQ(scdt_daemon_wait(&d, 60000), 0);
+  free(xyz);
+}
+
+int main(int argc, char **argv) {
+  scdt_init(argc, argv);
+  no_daemon();
+  refused();
+  failed_and_invalid();
+  connection_lost();
+  shutdown_();
+  return scdt_finish();
+}
