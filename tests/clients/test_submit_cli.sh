@@ -1,0 +1,102 @@
+#!/bin/sh
+# `shortcrust submit`, `stats` and `ping` end to end, against the daemon on
+# a private socket: submit writes the same mesh as reconstruct, in every
+# format, with the same summary and report; errors give the right status
+# and say why.
+#   test_submit_cli.sh SHORTCRUST SHORTCRUSTD MESHCMP DATADIR
+# SPDX-License-Identifier: GPL-3.0-or-later
+set -u
+sc=$1 scd=$2 meshcmp=$3 data=$4
+. "$(dirname "$0")/daemon.sh"
+fails=0
+fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
+
+# expect STATUS PATTERN CMD...: exit status and a message matching PATTERN.
+expect() {
+  want=$1 pat=$2
+  shift 2
+  "$@" >"$tmp/out" 2>"$tmp/err"
+  got=$?
+  [ "$got" -eq "$want" ] || fail "$* exited $got, expected $want: $(cat "$tmp/err")"
+  [ -z "$pat" ] || grep -q -- "$pat" "$tmp/out" "$tmp/err" || fail "$*: no '$pat' in: $(cat "$tmp/out" "$tmp/err")"
+}
+
+# Before any daemon: a clear message and status 1.
+expect 1 "daemon is not running" "$sc" ping --socket "$sock"
+expect 1 "daemon is not running" "$sc" stats --socket "$sock"
+expect 1 "daemon is not running" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --socket "$sock"
+[ -e "$tmp/x.ply" ] && fail "a failed submit wrote its output"
+
+start_daemon "$scd" "$sc" --workers 2
+
+expect 0 "usage: shortcrust submit" "$sc" submit --help
+for opt in --output --mode --r --theta --socket --report --ascii --no-normals --quiet; do
+  grep -q -- "$opt" "$tmp/out" || fail "submit --help does not mention $opt"
+done
+expect 0 "submit" "$sc" --help
+grep -q "stats" "$tmp/out" && grep -q "ping" "$tmp/out" || fail "--help lacks stats or ping"
+expect 0 "daemon alive, protocol 1" "$sc" ping --socket "$sock"
+
+# The same mesh as the local command: the same vertices and the same
+# triangles, and the same summary but for the times.
+mkdir "$tmp/a" "$tmp/b"
+for in in knot1_points kitten_points; do
+  for mode in "--mode cocone" "--mode shortcrust --r 0.14" "--mode auto" "--mode watertight"; do
+    expect 0 "" "$sc" submit "$data/$in.ply" -o "$tmp/a/m.ply" --socket "$sock" $mode --report "$tmp/a/r.json"
+    head -n 3 "$tmp/out" | sed "s|$tmp/a/||" > "$tmp/a/sum"
+    expect 0 "" "$sc" reconstruct "$data/$in.ply" -o "$tmp/b/m.ply" $mode --report "$tmp/b/r.json"
+    head -n 3 "$tmp/out" | sed "s|$tmp/b/||" > "$tmp/b/sum"
+    "$meshcmp" "$tmp/a/m.ply" "$tmp/b/m.ply" > "$tmp/cmp" || fail "$in $mode: $(cat "$tmp/cmp")"
+    cmp -s "$tmp/a/sum" "$tmp/b/sum" || fail "$in $mode: summaries differ: $(cat "$tmp/a/sum" "$tmp/b/sum")"
+    # The reports agree on the parameters, the genera and every diagnostic
+    # the protocol carries (PROTOCOL.md 6.12).
+    keys='"(input|params|points_in|duplicates_merged|delaunay_[a-z]*|hull_vertices|degenerate_cells|candidates|pruned|triangles|walk_rejected|holes_filled|hole_triangles|samples_unused|boundary_edges|boundary_loops|nonmanifold_[a-z]*|components|closed_components|boundary_samples|longest_loop|cells_relabelled|path|loops_by_length|closed|euler|genus|component_genus)":'
+    grep -E "^  $keys" "$tmp/a/r.json" > "$tmp/a/diag"
+    grep -E "^  $keys" "$tmp/b/r.json" > "$tmp/b/diag"
+    [ "$(wc -l < "$tmp/a/diag")" -ge 30 ] || fail "report has too few diagnostics: $(cat "$tmp/a/r.json")"
+    cmp -s "$tmp/a/diag" "$tmp/b/diag" || fail "$in $mode: reports differ: $(diff "$tmp/a/diag" "$tmp/b/diag")"
+    grep -q '"command": "submit"' "$tmp/a/r.json" || fail "report lacks the command"
+    grep -q '"transfer": ' "$tmp/a/r.json" || fail "report lacks the transfer time"
+  done
+done
+
+# Every output format, and the closed genus-1 knot in each.
+for out in k.obj k.off k.stl; do
+  expect 0 "Closed 2-manifold, 1 component, genus 1" \
+    "$sc" submit "$data/knot1_points.ply" -o "$tmp/$out" --socket "$sock"
+done
+expect 0 "" "$sc" submit "$data/knot1_points.ply" -o "$tmp/k.ply" --socket "$sock" --ascii --no-normals
+head -c 20 "$tmp/k.ply" | grep -q "format ascii" || head -n 2 "$tmp/k.ply" | grep -q "format ascii" || fail "--ascii did not write ascii PLY"
+grep -q "property float nx" "$tmp/k.ply" && fail "--no-normals wrote normals"
+expect 0 "" "$sc" submit "$data/knot1_points.ply" -o "$tmp/q.ply" --socket "$sock" --quiet
+[ -s "$tmp/out" ] && fail "--quiet printed: $(cat "$tmp/out")"
+
+# Bad command lines: status 2, before the daemon is asked anything.
+expect 2 "no input file" "$sc" submit -o "$tmp/x.ply" --socket "$sock"
+expect 2 "no output file" "$sc" submit "$data/knot1_points.ply" --socket "$sock"
+expect 2 "r must be in (0, 0.5)" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --r 0.7 --socket "$sock"
+expect 2 "unknown mode 'foo'" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --mode foo
+expect 2 "unknown option '--max-hole'" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --max-hole 5
+expect 2 "unknown extension '.xyz'" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.xyz"
+expect 2 "unknown option '--bogus'" "$sc" stats --bogus
+expect 2 "unknown option '--json'" "$sc" ping --json
+
+# Bad input: status 1 and why, from the file module or the daemon.
+expect 1 "missing.ply" "$sc" submit "$tmp/missing.ply" -o "$tmp/x.ply" --socket "$sock"
+printf '0 0 0\n1 0 0\n0 nan 1\n0 0 1\n1 1 1\n' > "$tmp/nan.xyz"
+expect 1 "NONFINITE" "$sc" submit "$tmp/nan.xyz" -o "$tmp/x.ply" --socket "$sock"
+printf '0 0 0\n1 0 0\n2 0 0\n3 0 0\n' > "$tmp/line.xyz"
+expect 1 "collinear" "$sc" submit "$tmp/line.xyz" -o "$tmp/x.ply" --socket "$sock"
+[ -e "$tmp/x.ply" ] && fail "a failed submit wrote its output"
+
+# The daemon's counters, as a table and as JSON.
+expect 0 "jobs_done_total" "$sc" stats --socket "$sock"
+grep -q "protocol 1" "$tmp/out" || fail "stats: no header line"
+expect 0 '"jobs_done_total": ' "$sc" stats --socket "$sock" --json
+[ "$(wc -l < "$tmp/out")" -eq 1 ] || fail "stats --json is not one line"
+grep -q '^{"socket": ".*"connections": [0-9]*.*}$' "$tmp/out" || fail "stats --json: $(cat "$tmp/out")"
+grep -q '"jobs_failed_total": 2[,}]' "$tmp/out" || fail "stats --json: two jobs failed: $(cat "$tmp/out")"
+
+stop_daemon
+[ "$fails" -eq 0 ] || { echo "$fails check(s) failed" >&2; cat "$tmp/daemon.log" >&2; exit 1; }
+echo "all submit, stats and ping checks passed"
