@@ -80,8 +80,13 @@ void set_msg(char *msg, size_t len, const char *fmt, ...) {
 }
 
 int check_params(const sc_params_t *p, char *msg, size_t len) {
-  if (p->mode < 0 || p->mode >= SC_MODE_COUNT_) {
-    set_msg(msg, len, "unknown mode %d", (int)p->mode);
+  // A C caller may store any int in the enum; in C++ loading a value
+  // outside the enum's range is undefined, so look at the bytes.
+  static_assert(sizeof(sc_mode_t) == sizeof(int), "mode is an int");
+  int mode;
+  std::memcpy(&mode, &p->mode, sizeof mode);
+  if (mode < 0 || mode >= SC_MODE_COUNT_) {
+    set_msg(msg, len, "unknown mode %d", mode);
     return SC_EINVALID_ARGUMENT;
   }
   if (!(p->r > 0 && p->r < 0.5)) {

@@ -8,6 +8,7 @@
 #include "shortcrust.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -25,7 +26,7 @@ constexpr uint64_t kBytesPerPoint = 1100;
 // Defaults of the boundary detection (see the README for the measurements
 // behind them); a parameter of 0 stands for these.
 constexpr double kDefaultRho = 1.3;
-constexpr double kDefaultAlpha = 0.35;
+constexpr double kDefaultAlpha = M_PI / 9; // 20 degrees
 
 // An error with a code from the public table, thrown inside the core and
 // turned into a return value at the C boundary.

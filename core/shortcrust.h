@@ -133,7 +133,7 @@ typedef struct sc_params {
   double boundary_rho;
   /* Poles of neighbouring interior samples agree when the angle between
    * them (unoriented) is at most this, radians, in (0, pi/2]; default
-   * 0.35 (20 degrees); 0 means the default. */
+   * pi/9 (20 degrees); 0 means the default. */
   double boundary_alpha;
 } sc_params_t;
 
