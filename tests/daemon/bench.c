@@ -124,25 +124,33 @@ static void latency(size_t n, int repeat) {
   double *xyz = scdt_sample(SC_SURF_SPHERE, n, 1);
   double *direct = calloc((size_t)repeat, sizeof *direct);
   double *daemon = calloc((size_t)repeat, sizeof *daemon);
+  double *pair = calloc((size_t)repeat, sizeof *pair);
+  double *dcpu = calloc((size_t)repeat, sizeof *dcpu);
+  double *scpu = calloc((size_t)repeat, sizeof *scpu);
   uint64_t direct_tri = 0, daemon_tri = 0;
   sc_params_t p;
   sc_params_init(&p);
-  for (int r = 0; r < repeat; r++) {
-    sc_mesh_t *m = NULL;
-    double t0 = seconds();
-    int rc = sc_reconstruct(xyz, n, &p, &m, NULL, 0);
-    direct[r] = seconds() - t0;
-    if (rc == 0)
-      direct_tri = m->triangle_count;
-    sc_mesh_free(m);
-  }
   scdt_daemon_t d;
   if (start(&d, 1) != 0) {
     fprintf(stderr, "daemon did not start\n");
     exit(1);
   }
-  for (int r = 0; r < repeat; r++)
+  /* Alternated, so that a change in the machine's load hits both alike. */
+  for (int r = 0; r < repeat; r++) {
+    sc_mesh_t *m = NULL;
+    double c0 = cpu_self();
+    double t0 = seconds();
+    int rc = sc_reconstruct(xyz, n, &p, &m, NULL, 0);
+    direct[r] = seconds() - t0;
+    dcpu[r] = cpu_self() - c0;
+    if (rc == 0)
+      direct_tri = m->triangle_count;
+    sc_mesh_free(m);
+    c0 = cpu_of(d.pid);
     daemon[r] = one_job(d.sock, xyz, n, &daemon_tri);
+    scpu[r] = cpu_of(d.pid) - c0;
+    pair[r] = daemon[r] / direct[r];
+  }
   scdt_daemon_stop(&d);
   double a = median(direct, repeat), b = median(daemon, repeat);
   printf("  direct sc_reconstruct  %8.3f s  (%llu triangles)\n", a,
@@ -150,9 +158,17 @@ static void latency(size_t n, int repeat) {
   printf("  through the daemon     %8.3f s  (%llu triangles, upload and "
          "download included)\n",
          b, (unsigned long long)daemon_tri);
-  printf("  ratio daemon/direct    %8.3f\n", b / a);
+  printf("  ratio daemon/direct    %8.3f  (median of the %d paired ratios: "
+         "%.3f)\n",
+         b / a, repeat, median(pair, repeat));
+  printf("  CPU: direct %.3f s, daemon %.3f s (ratio %.3f)\n",
+         median(dcpu, repeat), median(scpu, repeat),
+         median(scpu, repeat) / median(dcpu, repeat));
   free(direct);
   free(daemon);
+  free(pair);
+  free(dcpu);
+  free(scpu);
   free(xyz);
 }
 
