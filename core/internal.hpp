@@ -153,10 +153,13 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                       Progress &progress);
 // Closes every hole of at most max_loop edges by a least-area patch, except
-// loops mostly of samples marked in boundary (which may be empty).
+// the loops that boundary (which may be empty) marks as where the surface
+// ends. The patches together take at most max_work steps of the dynamic
+// programme (about L^3 / 6 for a loop of L edges); loops beyond it stay.
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                 size_t max_loop, const std::vector<uint8_t> &boundary,
-                Progress &progress, sc_diag_t &diag);
+                Progress &progress, sc_diag_t &diag,
+                uint64_t max_work = UINT64_MAX);
 
 // One reconstruction, fed all at once or in chunks.
 class Recon {

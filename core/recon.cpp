@@ -18,9 +18,13 @@ namespace sc {
 namespace {
 
 constexpr size_t kMaxPoints = 0xFFFFFFFEu;
-// The longest hole the watertight fallback fills: the least-area patch
-// costs the cube of the loop's length.
+// The longest hole the watertight closure by patches fills: the least-area
+// patch costs the cube of the loop's length ...
 constexpr size_t kMaxFillLoop = 2000;
+// ... and all its patches together take at most this many steps of the
+// dynamic programme (a few seconds; the ten merged bunny scans have dozens
+// of loops of 1000 to 2000 edges, which would take minutes).
+constexpr uint64_t kMaxFillWork = 500000000ull;
 // Closed components of fewer triangles than this, or than a thousandth of
 // the surface, are bubbles between scan layers in the modes for scans.
 constexpr size_t kMinBubble = 8;
@@ -46,18 +50,22 @@ template <class T> T *copy_out(const T *src, size_t count) {
   return p;
 }
 
-// What decides between two closed versions of a surface: a closed
-// manifold first, then the smaller genus, fewer components, more samples.
+// What decides between two closures of a surface: a closed manifold first,
+// then fewer loops left open, the smaller genus, fewer components, more
+// samples.
 struct Closure {
   bool ok;
   int64_t genus;
-  uint64_t components, unused;
+  uint64_t loops, components, unused;
   explicit Closure(const sc_diag_t &d)
       : ok(d.closed && !d.nonmanifold_edges && !d.nonmanifold_vertices),
-        genus(d.genus), components(d.components), unused(d.samples_unused) {}
+        genus(d.genus), loops(d.boundary_loops), components(d.components),
+        unused(d.samples_unused) {}
   bool better_than(const Closure &o) const {
     if (ok != o.ok)
       return ok;
+    if (loops != o.loops)
+      return loops < o.loops;
     if (genus != o.genus)
       return genus < o.genus;
     if (components != o.components)
@@ -109,7 +117,7 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   Surface b;
   sc_diag_t db = diag;
   describe(lxyz, m, extracted, progress, b, db);
-  fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db);
+  fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork);
   describe(lxyz, m, b.tris, progress, b, db);
 
   if (have_labels && !Closure(db).better_than(Closure(da))) {
@@ -122,6 +130,15 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
     diag.path = SC_PATH_WATERTIGHT_FILL;
   }
   diag.cells_relabelled = relabelled;
+  // Pockets: closing may leave small closed components inside the main one
+  // (the inside of a bubble, a cap that closed on itself). Those under a
+  // hundredth of the surface go; their samples may be attached later.
+  if (diag.components > 1) {
+    const uint64_t comps = diag.components;
+    drop_small_closed(surf.tris, surf, surf.tris.size() / 3 / 100);
+    describe(lxyz, m, surf.tris, progress, surf, diag);
+    diag.bubbles_dropped += comps - std::min(comps, diag.components);
+  }
   // Every loop of the extracted surface was closed if the result is.
   diag.holes_filled = diag.closed ? loops : 0;
   diag.hole_triangles = diag.triangles > before ? diag.triangles - before : 0;
@@ -235,19 +252,22 @@ sc_mesh_t *Recon::finish() {
           progress, surf, diag);
   if (detects_boundary(params_.mode)) {
     // Real scans: overlapping layers leave bubbles, small closed components
-    // between them, and samples the walk passed by. Drop the bubbles, then
-    // insert every sample near the surface into it.
+    // between them, and samples the walk passed by. Drop the bubbles;
+    // watertight mode closes the surface while every triangle is still a
+    // Delaunay facet (the labelling needs that); then every sample near the
+    // surface is inserted into it.
     const size_t before = surf.tris.size() / 3;
+    const uint64_t closed_before = diag.closed_components;
     drop_small_closed(surf.tris, surf,
                       std::max<size_t>(kMinBubble, before / 1000));
-    diag.bubbles_dropped = diag.closed_components;
+    describe(lxyz.data(), m, surf.tris, progress, surf, diag);
+    diag.bubbles_dropped =
+        closed_before - std::min(closed_before, diag.closed_components);
+    if (watertight)
+      close_surface(lxyz.data(), m, progress, surf, diag);
     diag.samples_attached = attach_samples(lxyz.data(), m, surf.tris, progress);
     describe(lxyz.data(), m, surf.tris, progress, surf, diag);
-    diag.bubbles_dropped -= std::min(diag.bubbles_dropped,
-                                     diag.closed_components);
   }
-  if (watertight)
-    close_surface(lxyz.data(), m, progress, surf, diag);
 
   // Per-vertex normals: the pole direction, signed to agree with the
   // area-weighted normal of the output triangles around the vertex.

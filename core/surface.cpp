@@ -292,7 +292,7 @@ bool is_triangle_of(const EdgeTable &et, const std::vector<uint32_t> &tris,
 // result stays a manifold.
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
                 size_t max_loop, const std::vector<uint8_t> &boundary,
-                Progress &progress, sc_diag_t &diag) {
+                Progress &progress, sc_diag_t &diag, uint64_t max_work) {
   if (res.empty())
     return;
   EdgeTable et;
@@ -361,6 +361,11 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
         continue;
     }
     const size_t L = loop.size();
+    // The dynamic programme costs about L^3 / 6 steps.
+    const uint64_t work = uint64_t(L) * L * L / 6;
+    if (work > max_work)
+      continue;
+    max_work -= work;
     // A three-edge loop around a lone triangle would be closed by a second
     // copy of that triangle.
     if (L == 3 && is_triangle_of(et, res, loop[0], loop[1], loop[2]))
