@@ -22,9 +22,15 @@
 atomic_int scdt_failures;
 
 static const char *daemon_path;
-#define SCDT_MAX_DAEMONS 16
-static scdt_daemon_t *daemons[SCDT_MAX_DAEMONS];
-static int ndaemons;
+/* What scdt_finish() needs of every daemon, copied: tests keep their
+ * scdt_daemon_t wherever they like, on the stack too. */
+#define SCDT_MAX_DAEMONS 32
+static struct record {
+  char dir[128];
+  char log[160];
+  pid_t pid;
+} records[SCDT_MAX_DAEMONS];
+static int nrecords;
 
 void scdt_init(int argc, char **argv) {
   signal(SIGPIPE, SIG_IGN);
@@ -45,11 +51,11 @@ void scdt_sleep_ms(unsigned ms) {
     ;
 }
 
-static void print_log(const scdt_daemon_t *d) {
-  FILE *f = fopen(d->log, "r");
+static void print_log(const char *log) {
+  FILE *f = fopen(log, "r");
   if (!f)
     return;
-  fprintf(stderr, "---- %s\n", d->log);
+  fprintf(stderr, "---- %s\n", log);
   char line[4096];
   while (fgets(line, sizeof line, f))
     fputs(line, stderr);
@@ -75,18 +81,18 @@ static void remove_dir(const char *dir) {
 
 int scdt_finish(void) {
   int failed = atomic_load(&scdt_failures);
-  for (int i = 0; i < ndaemons; i++) {
-    scdt_daemon_t *d = daemons[i];
-    if (d->pid > 0) {
-      kill(d->pid, SIGKILL);
-      waitpid(d->pid, NULL, 0);
-      d->pid = 0;
+  for (int i = 0; i < nrecords; i++) {
+    struct record *r = &records[i];
+    if (r->pid > 0) {
+      kill(r->pid, SIGKILL);
+      waitpid(r->pid, NULL, 0);
+      r->pid = 0;
     }
     if (failed || getenv("SCDT_SHOW_LOGS"))
-      print_log(d);
-    remove_dir(d->dir);
+      print_log(r->log);
+    remove_dir(r->dir);
   }
-  ndaemons = 0;
+  nrecords = 0;
   if (failed)
     fprintf(stderr, "%d check(s) failed\n", failed);
   return failed ? 1 : 0;
@@ -97,6 +103,7 @@ void scdt_abort(void) { exit(scdt_finish() ? 1 : 1); }
 int scdt_daemon_prepare(scdt_daemon_t *d) {
   memset(d, 0, sizeof *d);
   d->status = -1;
+  d->slot = -1;
   const char *tmp = getenv("TMPDIR");
   /* A socket path must fit in 108 bytes. */
   if (!tmp || !*tmp || strlen(tmp) > 60)
@@ -108,8 +115,13 @@ int scdt_daemon_prepare(scdt_daemon_t *d) {
   }
   snprintf(d->sock, sizeof d->sock, "%s/d.sock", d->dir);
   snprintf(d->log, sizeof d->log, "%s/daemon.log", d->dir);
-  if (ndaemons < SCDT_MAX_DAEMONS)
-    daemons[ndaemons++] = d;
+  if (nrecords < SCDT_MAX_DAEMONS) {
+    d->slot = nrecords++;
+    struct record *r = &records[d->slot];
+    snprintf(r->dir, sizeof r->dir, "%s", d->dir);
+    snprintf(r->log, sizeof r->log, "%s", d->log);
+    r->pid = 0;
+  }
   return 0;
 }
 
@@ -146,6 +158,8 @@ int scdt_daemon_spawn(scdt_daemon_t *d, const char *const *args,
   close(logfd);
   d->pid = pid;
   d->status = -1;
+  if (d->slot >= 0)
+    records[d->slot].pid = pid;
   if (!wait_ready)
     return 0;
   /* Sanitizer builds start slowly. */
@@ -182,6 +196,8 @@ int scdt_daemon_wait(scdt_daemon_t *d, int timeout_ms) {
     int st;
     pid_t r = waitpid(d->pid, &st, WNOHANG);
     if (r == d->pid) {
+      if (d->slot >= 0 && records[d->slot].pid == d->pid)
+        records[d->slot].pid = 0;
       d->pid = 0;
       d->status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
       return d->status;

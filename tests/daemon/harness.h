@@ -59,6 +59,7 @@ typedef struct scdt_daemon {
   char sock[160];
   char log[160];
   int status; /* exit code once it has exited, or 128 + signal */
+  int slot;   /* the harness's own record of it, for scdt_finish() */
 } scdt_daemon_t;
 
 /* argv[1] is the daemon binary. Also ignores SIGPIPE. */
