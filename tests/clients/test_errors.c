@@ -254,7 +254,10 @@ static void connection_lost(void) {
   /* A second job, whose end is the same. */
   CHECK_EQ(sc_client_submit(c, NULL, xyz, 1000, &k), 0);
   CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), SC_CLIENT_ELOST);
-  CHECK_MSG(sc_client_job_message(j), "closed the connection");
+  /* A killed daemon shows as end of file or, when the kernel still held
+   * unread upload bytes for it, as a reset: either message names the
+   * connection. */
+  CHECK_MSG(sc_client_job_message(j), "connection");
   CHECK_EQ(sc_client_wait(c, k, SCCT_WAIT_MS), SC_CLIENT_ELOST);
   CHECK_EQ(sc_client_status(c), SC_CLIENT_ELOST);
   CHECK_EQ(sc_client_jobs_in_use(c), 0);
@@ -263,7 +266,7 @@ static void connection_lost(void) {
   CHECK_EQ(sc_client_submit(c, NULL, xyz, 1000, &l), SC_CLIENT_ELOST);
   CHECK(l == NULL, "a job on a dead connection");
   CHECK_EQ(sc_client_ping(c, 1000, NULL), SC_CLIENT_ELOST);
-  CHECK_MSG(sc_client_last_error(c), "closed the connection");
+  CHECK_MSG(sc_client_last_error(c), "connection");
   sc_client_job_free(j);
   sc_client_job_free(k);
   sc_client_free(c);
