@@ -900,10 +900,7 @@ double dist2(const double *x, const double *y) {
 void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
                        size_t min_triangles) {
   const size_t nt = tris.size() / 3;
-  // Components in the order describe() numbered them: by first triangle.
-  std::vector<size_t> size;
-  std::vector<int32_t> comp(nt, -1);
-  // describe() kept no per-triangle component, so recount over edges.
+  // describe() keeps no per-triangle component, so count them again.
   std::vector<std::pair<uint64_t, uint32_t>> edges;
   edges.reserve(3 * nt);
   for (size_t t = 0; t < nt; ++t)
@@ -1032,17 +1029,15 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
       add(v[1], v[2], s);
       add(v[2], v[0], s);
     } else {
-      // The edge: opposite the zero weight; at a corner, the edge of the
-      // two nonzero... the corner's edges, the one nearer the sample.
+      // The edge opposite the zero weight; at a corner, of the corner's two
+      // edges the one whose other end is nearer the sample (edge c-(c+1)
+      // is opposite c+2).
       int k = zero;
       if (zero == 3) {
         int c = bw[0] > 0.5 ? 0 : bw[1] > 0.5 ? 1 : 2;
-        const double *pc = xyz + 3 * size_t(v[c]);
         const double *n1 = xyz + 3 * size_t(v[(c + 1) % 3]),
                      *n2 = xyz + 3 * size_t(v[(c + 2) % 3]);
-        // Keep the edge c-(c+1) (opposite c+2) or c-(c+2) (opposite c+1).
         k = dist2(p, n1) <= dist2(p, n2) ? (c + 2) % 3 : (c + 1) % 3;
-        (void)pc;
       }
       uint32_t a = v[(k + 1) % 3], b = v[(k + 2) % 3], c = v[k];
       // The other triangle on edge a-b, running b -> a.
