@@ -534,6 +534,8 @@ static void send_job_done(scd_conn_t *c, scd_job_t *j) {
       U("loops.101_1000", d->loops_by_length[2]),
       U("loops.over_1000", d->loops_by_length[3]),
       U("cells_relabelled", d->cells_relabelled),
+      U("bubbles_dropped", d->bubbles_dropped),
+      U("samples_attached", d->samples_attached),
       F("seconds.upload", ms_between(j->begin_ns, j->end_ns) / 1e3),
       F("seconds.server", ms_between(j->begin_ns, uv_hrtime()) / 1e3),
   };
