@@ -47,6 +47,7 @@ demo: build
 
 bench: build
 	$(BUILD)/bin/shortcrust-bench
+	$(BUILD)/bin/shortcrustd-bench
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-asan $(BUILD)-tsan $(BUILD)-fuzz

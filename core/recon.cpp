@@ -74,6 +74,31 @@ struct Closure {
   }
 };
 
+// Puts the triangles in one order that depends only on the set: each
+// rotated (keeping its orientation) to start at its smallest index, then
+// sorted. Which Delaunay cell reports a facet depends on heap addresses, so
+// without this two runs on the same points list the same triangles in
+// different orders; with it a daemon job and a local run write identical
+// files.
+void canonical_order(std::vector<uint32_t> &tris) {
+  struct Tri {
+    uint32_t v[3];
+  };
+  const size_t nt = tris.size() / 3;
+  std::vector<Tri> t(nt);
+  for (size_t i = 0; i < nt; ++i) {
+    const uint32_t *s = &tris[3 * i];
+    int k = s[0] < s[1] ? (s[0] < s[2] ? 0 : 2) : (s[1] < s[2] ? 1 : 2);
+    for (int j = 0; j < 3; ++j)
+      t[i].v[j] = s[(k + j) % 3];
+  }
+  std::sort(t.begin(), t.end(), [](const Tri &a, const Tri &b) {
+    return std::lexicographical_compare(a.v, a.v + 3, b.v, b.v + 3);
+  });
+  for (size_t i = 0; i < nt; ++i)
+    std::memcpy(&tris[3 * i], t[i].v, sizeof t[i].v);
+}
+
 } // namespace
 
 // Watertight mode, after extraction: closes the open components of surf.
@@ -310,6 +335,7 @@ sc_mesh_t *Recon::finish() {
       normals[3 * size_t(d.first) + j] = normals[3 * size_t(d.second) + j];
   for (uint32_t &v : surf.tris)
     v = f.to_input[v];
+  canonical_order(surf.tris);
   seconds_[SC_STAGE_EXTRACT] += sw.lap();
 
   for (int s = 0; s < SC_STAGE_COUNT; ++s) {
