@@ -601,6 +601,21 @@ private:
       }
     }
 
+    // Auto mode: when most samples are not interior the sample is too
+    // sparse or too small to tell a boundary from undersampling (every
+    // sample of a tetrahedron is a boundary sample), and boundary mode
+    // would keep nothing; run the closed-surface algorithm instead.
+    size_t interior = 0;
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v)
+      interior += (v->info().flags & kVInterior) != 0;
+    if (params.mode == SC_MODE_AUTO && 2 * interior < m) {
+      for (auto v = dt_.finite_vertices_begin();
+           v != dt_.finite_vertices_end(); ++v)
+        v->info().flags |= kVInterior;
+      boundary.clear();
+      return;
+    }
     boundary.assign(m, 0);
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v) {
