@@ -7,8 +7,8 @@
 // FILE names a point file in DATA_DIR without its .ply extension; the
 // default is the list below. For each file and method: triangles, samples
 // used (vertices / distinct points), non-manifold edges and vertices,
-// orientation errors, boundary loops, components, closed or not, genus of
-// the closed components, the distance from the output to the ground-truth
+// orientation errors, boundary loops, components, closed or not, genus
+// summed over the components (open ones included), the distance from the output to the ground-truth
 // mesh where there is one (RMS and maximum over the triangle centroids and
 // vertices, point to triangle, in units of the file's median sample
 // spacing), and the time beside CGAL's Delaunay triangulation of the same
@@ -117,16 +117,13 @@ void row(const char *file, const char *method, const char *path,
     std::printf("| %s | %s | meshcheck failed |\n", file, method);
     return;
   }
-  std::string genus;
-  for (size_t i = 0; i < c.component_count; ++i) {
-    if (!c.comp[i].closed)
-      continue;
-    if (genus.size() > 24) {
-      genus += ",...";
-      break;
-    }
-    genus += (genus.empty() ? "" : ",") + std::to_string(c.comp[i].genus);
-  }
+  // Genus summed over the components, open ones included (a component with
+  // boundary has genus (2 - chi - b) / 2), so that handles show whether or
+  // not the surface is closed.
+  long long genus = 0;
+  for (size_t i = 0; i < c.component_count; ++i)
+    if (c.comp[i].genus > 0)
+      genus += c.comp[i].genus;
   char dist[64] = "-";
   if (ref) {
     double rms, max;
@@ -135,7 +132,7 @@ void row(const char *file, const char *method, const char *path,
                   max / spacing);
   }
   std::printf("| %s | %s | %s | %zu | %.2f%% | %llu / %llu | %llu | %llu | "
-              "%llu | %s | %s | %s | %.2f s | %.2f |\n",
+              "%llu | %s | %lld | %s | %.2f s | %.2f |\n",
               file, method, path, nt,
               100.0 * double(c.vertices_used) / double(points),
               (unsigned long long)c.nonmanifold_edges,
@@ -143,7 +140,7 @@ void row(const char *file, const char *method, const char *path,
               (unsigned long long)c.orientation_errors,
               (unsigned long long)c.boundary_loops,
               (unsigned long long)c.components, c.closed ? "yes" : "no",
-              genus.empty() ? "-" : genus.c_str(), dist, seconds,
+              genus, dist, seconds,
               seconds / dt_seconds);
   std::fflush(stdout);
   sc_meshcheck_free(&c);
@@ -152,9 +149,17 @@ void row(const char *file, const char *method, const char *path,
 } // namespace
 
 int main(int argc, char **argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: %s DATA_DIR [FILE ...]\n", argv[0]);
-    return 2;
+  if (argc < 2 || argv[1][0] == '-') {
+    bool help = argc >= 2 && (std::strcmp(argv[1], "--help") == 0 ||
+                              std::strcmp(argv[1], "-h") == 0);
+    std::fprintf(help ? stdout : stderr,
+                 "usage: %s DATA_DIR [FILE ...]\n\n"
+                 "Runs every mode and CGAL's advancing front on the point "
+                 "files\nDATA_DIR/FILE.ply (default: the bunny scans, "
+                 "cgal_kitten_normals\nand cgal_half) and prints one "
+                 "Markdown table.\n",
+                 argv[0]);
+    return help ? 0 : 2;
   }
   const std::string dir = argv[1];
   std::vector<std::string> files;
@@ -171,7 +176,7 @@ int main(int argc, char **argv) {
 
   std::printf("| file | method | path | triangles | samples used | "
               "non-manifold edges / vertices | orientation errors | "
-              "boundary loops | components | closed | genus (closed) | "
+              "boundary loops | components | closed | genus (sum) | "
               "distance to GT, RMS / max (spacings) | time | time / CGAL "
               "Delaunay |\n");
   std::printf("|---|---|---|--:|--:|--:|--:|--:|--:|---|---|--:|--:|--:|\n");
