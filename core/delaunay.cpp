@@ -13,6 +13,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <CGAL/hilbert_sort.h>
 #include <CGAL/spatial_sort.h>
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
 #ifdef CGAL_LINKED_WITH_TBB
@@ -20,6 +21,7 @@
 #endif
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -154,6 +156,47 @@ V3 cell_circumcentre(V3 a, V3 b, V3 c, V3 d, bool &guarded) {
     }
   }
   return out;
+}
+
+// The points of an xyz array by index, as a property map for CGAL's sorts.
+struct XyzMap {
+  const double *xyz;
+  typedef uint32_t key_type;
+  typedef Point value_type;
+  typedef Point reference;
+  typedef boost::readable_property_map_tag category;
+  friend Point get(const XyzMap &m, uint32_t i) {
+    return Point(m.xyz[3 * size_t(i)], m.xyz[3 * size_t(i) + 1],
+                 m.xyz[3 * size_t(i) + 2]);
+  }
+};
+
+// Puts the triangles in an order that depends only on the set: each with
+// its vertex numbers ascending, then sorted. The candidates carry no
+// orientation; the walk gives them one.
+void sort_triangles(std::vector<uint32_t> &tris) {
+  const size_t nt = tris.size() / 3;
+  for (size_t t = 0; t < nt; ++t) {
+    uint32_t *v = &tris[3 * t];
+    if (v[0] > v[1])
+      std::swap(v[0], v[1]);
+    if (v[1] > v[2])
+      std::swap(v[1], v[2]);
+    if (v[0] > v[1])
+      std::swap(v[0], v[1]);
+  }
+  std::vector<uint32_t> order(nt);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return std::lexicographical_compare(&tris[3 * size_t(a)],
+                                        &tris[3 * size_t(a)] + 3,
+                                        &tris[3 * size_t(b)],
+                                        &tris[3 * size_t(b)] + 3);
+  });
+  std::vector<uint32_t> out(tris.size());
+  for (size_t i = 0; i < nt; ++i)
+    std::memcpy(&out[3 * i], &tris[3 * size_t(order[i])], 3 * sizeof(uint32_t));
+  tris.swap(out);
 }
 
 // The thresholds of the candidate tests, computed once from the parameters.
@@ -296,16 +339,13 @@ public:
     resolve_duplicates(xyz, n, out.dups);
     diag.duplicates_merged = out.dups.size();
     diag.delaunay_vertices = dt_.number_of_vertices();
-    // From here on vertices go by their rank in the triangulation's own
-    // order, which follows the spatial sort: every later array indexed by
-    // vertex is then read with locality, whatever the input order.
-    out.to_input.clear();
-    out.to_input.reserve(dt_.number_of_vertices());
-    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
-         ++v) {
-      out.to_input.push_back(v->info().idx);
-      v->info().idx = uint32_t(out.to_input.size() - 1);
-    }
+    // From here on vertices go by their rank in a Hilbert order of the
+    // points: every later array indexed by vertex is then read with
+    // locality, whatever the input order; and the numbering depends only on
+    // the points, not on the order in which they were inserted (all at once
+    // here, in chunks as they arrive in the daemon), so neither do the
+    // candidates, pruning and walk, and both give the same mesh.
+    number_vertices(xyz, n, out.to_input);
     seconds[SC_STAGE_DELAUNAY] += sw.lap();
 
     progress.stage(SC_STAGE_POLES);
@@ -317,6 +357,9 @@ public:
     progress.stage(SC_STAGE_CANDIDATES);
     select_candidates(params, progress, out.tris, diag);
     diag.candidates = out.tris.size() / 3;
+    // Which cell reports a facet, and when, depends on heap addresses; the
+    // later stages break ties by the order of the candidates.
+    sort_triangles(out.tris);
     // The triangulation is not needed any more: free it before pruning so
     // that the peak memory is the triangulation's alone.
     if (!keep)
@@ -334,6 +377,27 @@ public:
 private:
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
+
+  // Numbers the vertices 0, 1, ... in the Hilbert order of their points
+  // (ties by input index) and fills to_input (vertex number -> input index).
+  void number_vertices(const double *xyz, size_t n,
+                       std::vector<uint32_t> &to_input) {
+    to_input.clear();
+    to_input.reserve(dt_.number_of_vertices());
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v)
+      to_input.push_back(v->info().idx);
+    std::sort(to_input.begin(), to_input.end());
+    CGAL::hilbert_sort(to_input.begin(), to_input.end(),
+                       CGAL::Spatial_sort_traits_adapter_3<K, XyzMap>(
+                           XyzMap{xyz}));
+    std::vector<uint32_t> rank(n);
+    for (size_t i = 0; i < to_input.size(); ++i)
+      rank[to_input[i]] = uint32_t(i);
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v)
+      v->info().idx = rank[v->info().idx];
+  }
 
   // Range insertion keeps one of several equal points, with whatever index
   // came last in its spatial order. Find each missing index, record it as a
@@ -699,18 +763,32 @@ private:
         queue.push_back(c);
     }
     progress.tick(nt, 4 * nt + 1);
-    for (size_t head = 0; head < queue.size(); ++head) {
-      Ch c = queue[head];
-      const CellLabel w = c->info().w;
-      for (int f = 0; f < 4; ++f) {
-        if (w.barrier & (1u << f))
-          continue;
-        Ch nb = c->neighbor(f);
-        if (nb->info().w.label == kUnlabelled) {
-          nb->info().w.label = w.label;
-          queue.push_back(nb);
+    // Level by level, so that the result does not depend on the order of
+    // the cells in memory: a cell reached from the last level takes the
+    // label of most of its neighbours there (outside on a tie), counted in
+    // w.local (inside in the high half).
+    std::vector<Ch> next;
+    while (!queue.empty()) {
+      next.clear();
+      for (Ch c : queue) {
+        const CellLabel w = c->info().w;
+        for (int f = 0; f < 4; ++f) {
+          if (w.barrier & (1u << f))
+            continue;
+          CellLabel &v = c->neighbor(f)->info().w;
+          if (v.label != kUnlabelled)
+            continue;
+          if (v.local == 0)
+            next.push_back(c->neighbor(f));
+          v.local += w.label == kInside ? 1u << 16 : 1u;
         }
       }
+      for (Ch c : next) {
+        CellLabel &w = c->info().w;
+        w.label = (w.local >> 16) > (w.local & 0xFFFFu) ? kInside : kOutside;
+        w.local = 0;
+      }
+      queue.swap(next);
     }
     queue = std::vector<Ch>();
     progress.tick(2 * nt, 4 * nt + 1);
@@ -759,6 +837,9 @@ private:
         moved.clear();
         if (!repair_vertex(v, max_moves, keep_seeds, moved, diag))
           unresolved.push_back(v);
+        std::sort(moved.begin(), moved.end(), [](Vh a, Vh b) {
+          return a->info().idx < b->info().idx;
+        });
         for (Vh u : moved)
           if (!queued[u->info().idx]) {
             queued[u->info().idx] = 1;
@@ -791,6 +872,17 @@ private:
     return true;
   }
 
+  // The vertex numbers of a cell, ascending (the infinite vertex last): a
+  // key that does not depend on where the cell lies in memory.
+  std::array<uint32_t, 4> cell_key(Ch c) const {
+    std::array<uint32_t, 4> k;
+    for (int j = 0; j < 4; ++j)
+      k[j] = dt_.is_infinite(c->vertex(j)) ? UINT32_MAX
+                                            : c->vertex(j)->info().idx;
+    std::sort(k.begin(), k.end());
+    return k;
+  }
+
   // Around vertex v, the cells of each label must form one piece, joined
   // across the facets at v. If they do not, moves the smallest piece that
   // may move (of a split label if possible; otherwise of the other label,
@@ -804,6 +896,9 @@ private:
     std::vector<Ch> &inc = star_;
     inc.clear();
     dt_.incident_cells(v, std::back_inserter(inc));
+    // In an order that depends on the vertices only, not on the memory.
+    std::sort(inc.begin(), inc.end(),
+              [&](Ch a, Ch b) { return cell_key(a) < cell_key(b); });
     const size_t k = inc.size();
     for (size_t i = 0; i < k; ++i)
       inc[i]->info().w.local = uint32_t(i);

@@ -123,6 +123,7 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   }
   std::vector<uint32_t> extracted = surf.tris, labelled = open;
   const bool have_labels = dt_->close(labelled, progress, diag);
+  canonical_order(labelled);
   dt_.reset();
   const uint64_t relabelled = diag.cells_relabelled;
 
