@@ -139,9 +139,11 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
               Progress &progress, Surface &out, sc_diag_t &diag);
 // Removes the closed components of fewer than min_triangles triangles
-// (bubbles between the layers of overlapping scans); s describes tris.
+// (bubbles between the layers of overlapping scans), and the open ones too
+// when open_too; s describes tris.
 void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
-                       size_t min_triangles);
+                       size_t min_triangles,
+                       bool open_too = false);
 // Inserts every sample that is in no triangle into the nearest triangle
 // (splitting it in three, or the two triangles of the nearest edge in
 // two each) when it is closer to it than the triangle's longest edge.
@@ -152,9 +154,10 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 // largest fan at each vertex: what is left is a 2-manifold (with boundary).
 void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                       Progress &progress);
-// Closes every hole of at most max_loop edges by a least-area patch, except
-// the loops that boundary (which may be empty) marks as where the surface
-// ends. The patches together take at most max_work steps of the dynamic
+// Closes every hole of at most max_loop edges by a least-area patch (a loop
+// of more than a few hundred edges is first cut by short chords into
+// pieces), except the loops that boundary (which may be empty) marks as
+// where the surface ends. The patches together take at most max_work steps of the dynamic
 // programme (about L^3 / 6 for a loop of L edges); loops beyond it stay.
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                 size_t max_loop, const std::vector<uint8_t> &boundary,

@@ -18,13 +18,13 @@ namespace sc {
 namespace {
 
 constexpr size_t kMaxPoints = 0xFFFFFFFEu;
-// The longest hole the watertight closure by patches fills: the least-area
-// patch costs the cube of the loop's length ...
-constexpr size_t kMaxFillLoop = 2000;
-// ... and all its patches together take at most this many steps of the
-// dynamic programme (a few seconds; the ten merged bunny scans have dozens
-// of loops of 1000 to 2000 edges, which would take minutes).
-constexpr uint64_t kMaxFillWork = 500000000ull;
+// The watertight closure by patches fills holes of any length: a long loop
+// is cut into pieces of a few hundred edges first (the least-area patch
+// costs the cube of the length) ...
+constexpr size_t kMaxFillLoop = std::numeric_limits<size_t>::max();
+// ... and all the patches together take at most this many steps of the
+// dynamic programme (seconds).
+constexpr uint64_t kMaxFillWork = 2000000000ull;
 // Closed components of fewer triangles than this, or than a thousandth of
 // the surface, are bubbles between scan layers in the modes for scans.
 constexpr size_t kMinBubble = 8;
@@ -145,6 +145,16 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   describe(lxyz, m, extracted, progress, b, db);
   fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork);
   describe(lxyz, m, b.tris, progress, b, db);
+  // Debris, such as lone triangles between scan layers, cannot be closed:
+  // small open components go from both closures (their samples may be
+  // attached later).
+  for (auto [s, d] : {std::pair<Surface *, sc_diag_t *>{&a, &da}, {&b, &db}})
+    if (!d->closed && d->components > 1 && !s->tris.empty()) {
+      drop_small_closed(s->tris, *s,
+                        std::max<size_t>(kMinBubble, s->tris.size() / 3 / 1000),
+                        true);
+      describe(lxyz, m, s->tris, progress, *s, *d);
+    }
 
   if (have_labels && !Closure(db).better_than(Closure(da))) {
     surf = std::move(a);

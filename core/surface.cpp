@@ -18,6 +18,9 @@ namespace {
 // Boundary mode leaves open the loops of at least this many edges that run
 // mostly through samples whose cells open sideways (see fill_holes()).
 constexpr size_t kMinOpenLoop = 8;
+// Loops longer than this are cut into pieces before they are patched: the
+// least-area patch costs the cube of the length.
+constexpr size_t kMaxPatch = 200;
 
 inline uint64_t edge_key(uint32_t a, uint32_t b) {
   return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
@@ -283,6 +286,110 @@ bool is_triangle_of(const EdgeTable &et, const std::vector<uint32_t> &tris,
   return false;
 }
 
+// Patches the loop (vertex numbers in order; the hole runs along it) with
+// the triangulation of least total area whose chords are all new edges, and
+// appends its triangles to res and its chords to `chords`. The edge from the
+// last vertex back to the first is part of the loop. Returns false when no
+// such triangulation exists.
+template <class HasEdge>
+bool patch(const double *xyz, const std::vector<uint32_t> &loop,
+           HasEdge has_edge, std::vector<double> &cost,
+           std::vector<uint32_t> &split, std::vector<uint32_t> &res,
+           std::vector<uint64_t> &chords) {
+  const size_t L = loop.size();
+  auto area = [&](size_t i, size_t k, size_t j) {
+    const double *a = xyz + 3 * size_t(loop[i]), *b = xyz + 3 * size_t(loop[k]),
+                 *c = xyz + 3 * size_t(loop[j]);
+    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double x = u[1] * w[2] - u[2] * w[1], y = u[2] * w[0] - u[0] * w[2],
+           z = u[0] * w[1] - u[1] * w[0];
+    return std::sqrt(x * x + y * y + z * z);
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  cost.assign(L * L, inf);
+  split.assign(L * L, UINT32_MAX);
+  for (size_t i = 0; i + 1 < L; ++i)
+    cost[i * L + i + 1] = 0;
+  for (size_t len = 2; len < L; ++len) {
+    for (size_t i = 0; i + len < L; ++i) {
+      size_t j = i + len;
+      // (0, L-1) is a loop edge; any other chord must be a new edge.
+      if (!(i == 0 && j == L - 1) && has_edge(loop[i], loop[j]))
+        continue;
+      for (size_t k = i + 1; k < j; ++k) {
+        double c = cost[i * L + k] + cost[k * L + j];
+        if (c == inf)
+          continue;
+        c += area(i, k, j);
+        if (c < cost[i * L + j]) {
+          cost[i * L + j] = c;
+          split[i * L + j] = uint32_t(k);
+        }
+      }
+    }
+  }
+  if (cost[L - 1] == inf)
+    return false;
+  std::vector<std::pair<size_t, size_t>> stack{{0, L - 1}};
+  while (!stack.empty()) {
+    auto [i, j] = stack.back();
+    stack.pop_back();
+    if (j - i < 2)
+      continue;
+    size_t k = split[i * L + j];
+    res.push_back(loop[i]);
+    res.push_back(loop[k]);
+    res.push_back(loop[j]);
+    if (k - i > 1)
+      chords.push_back(edge_key(loop[i], loop[k]));
+    if (j - k > 1)
+      chords.push_back(edge_key(loop[k], loop[j]));
+    stack.push_back({i, k});
+    stack.push_back({k, j});
+  }
+  return true;
+}
+
+// Cuts a loop in two by its shortest new chord between vertices about half
+// the loop apart: `loop` keeps the part from one end of the chord to the
+// other, `rest` gets the other part; both then end with the chord. Returns
+// false when every such chord is an edge already.
+template <class HasEdge>
+bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
+              std::vector<uint32_t> &rest, HasEdge has_edge) {
+  const size_t L = loop.size(), half = L / 2, window = L / 8;
+  double best = std::numeric_limits<double>::infinity();
+  size_t bi = 0, bj = 0;
+  for (size_t i = 0; i < L; ++i) {
+    const double *a = xyz + 3 * size_t(loop[i]);
+    for (size_t d = half - window; d <= half + window; ++d) {
+      size_t j = (i + d) % L;
+      const double *b = xyz + 3 * size_t(loop[j]);
+      double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+      double d2 = dx * dx + dy * dy + dz * dz;
+      if (d2 < best && loop[i] != loop[j] && !has_edge(loop[i], loop[j]))
+        best = d2, bi = i, bj = j;
+    }
+  }
+  if (!(best < std::numeric_limits<double>::infinity()))
+    return false;
+  std::vector<uint32_t> a, b;
+  for (size_t k = bi;; k = (k + 1) % L) {
+    a.push_back(loop[k]);
+    if (k == bj)
+      break;
+  }
+  for (size_t k = bj;; k = (k + 1) % L) {
+    b.push_back(loop[k]);
+    if (k == bi)
+      break;
+  }
+  loop.swap(a);
+  rest.swap(b);
+  return true;
+}
+
 } // namespace
 
 // Closes the holes of an edge-manifold, consistently oriented, vertex-
@@ -326,6 +433,7 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     }
   }
   std::vector<uint32_t> loop;
+  std::vector<std::vector<uint32_t>> loops, pieces;
   std::vector<double> cost;
   std::vector<uint32_t> split;
   std::vector<uint8_t> seen(n, 0);
@@ -360,69 +468,59 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
       if (2 * opens >= loop.size())
         continue;
     }
-    const size_t L = loop.size();
-    // The dynamic programme costs about L^3 / 6 steps.
-    const uint64_t work = uint64_t(L) * L * L / 6;
-    if (work > max_work)
-      continue;
-    max_work -= work;
     // A three-edge loop around a lone triangle would be closed by a second
     // copy of that triangle.
-    if (L == 3 && is_triangle_of(et, res, loop[0], loop[1], loop[2]))
+    if (loop.size() == 3 &&
+        is_triangle_of(et, res, loop[0], loop[1], loop[2]))
       continue;
-    auto area = [&](size_t i, size_t k, size_t j) {
-      const double *a = xyz + 3 * size_t(loop[i]), *b = xyz + 3 * size_t(loop[k]),
-                   *c = xyz + 3 * size_t(loop[j]);
-      double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-      double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-      double x = u[1] * w[2] - u[2] * w[1], y = u[2] * w[0] - u[0] * w[2],
-             z = u[0] * w[1] - u[1] * w[0];
-      return std::sqrt(x * x + y * y + z * z);
-    };
-    const double inf = std::numeric_limits<double>::infinity();
-    cost.assign(L * L, inf);
-    split.assign(L * L, UINT32_MAX);
-    for (size_t i = 0; i + 1 < L; ++i)
-      cost[i * L + i + 1] = 0;
-    for (size_t len = 2; len < L; ++len) {
-      for (size_t i = 0; i + len < L; ++i) {
-        size_t j = i + len;
-        // (0, L-1) is a loop edge; any other chord must be a new edge.
-        if (!(i == 0 && j == L - 1) && has_edge(loop[i], loop[j]))
-          continue;
-        for (size_t k = i + 1; k < j; ++k) {
-          double c = cost[i * L + k] + cost[k * L + j];
-          if (c == inf)
-            continue;
-          c += area(i, k, j);
-          if (c < cost[i * L + j]) {
-            cost[i * L + j] = c;
-            split[i * L + j] = uint32_t(k);
-          }
+    loops.push_back(loop);
+  }
+  // Shortest first: when the work runs out, the many small holes are
+  // closed and a few long ones stay open, not the other way round.
+  std::stable_sort(loops.begin(), loops.end(),
+                   [](const std::vector<uint32_t> &a,
+                      const std::vector<uint32_t> &b) {
+                     return a.size() < b.size();
+                   });
+  for (const std::vector<uint32_t> &hole : loops) {
+    // A long loop is first cut by short chords into pieces of at most
+    // kMaxPatch edges; the pieces are patched one by one, and the hole is
+    // filled only if all of them are.
+    pieces.assign(1, hole);
+    std::vector<uint64_t> cuts;
+    bool cut_ok = true;
+    for (size_t p = 0; p < pieces.size() && cut_ok; ++p) {
+      while (pieces[p].size() > kMaxPatch) {
+        std::vector<uint32_t> rest;
+        if (!cut_loop(xyz, pieces[p], rest, has_edge)) {
+          cut_ok = false;
+          break;
         }
+        const std::vector<uint32_t> &q = pieces[p];
+        cuts.push_back(edge_key(q.front(), q.back()));
+        chords.insert(cuts.back());
+        pieces.push_back(std::move(rest));
       }
     }
-    if (cost[L - 1] == inf)
+    uint64_t work = 0;
+    for (const auto &q : pieces)
+      work += uint64_t(q.size()) * q.size() * q.size() / 6;
+    const size_t before = res.size();
+    std::vector<uint64_t> added_chords;
+    bool ok_all = cut_ok && work <= max_work;
+    for (size_t p = 0; p < pieces.size() && ok_all; ++p)
+      ok_all = patch(xyz, pieces[p], has_edge, cost, split, res, added_chords);
+    if (ok_all) {
+      max_work -= work;
+      chords.insert(added_chords.begin(), added_chords.end());
+    } else {
+      // Not all pieces could be patched: leave the hole as it was.
+      res.resize(before);
+      for (uint64_t k : cuts)
+        chords.erase(k);
       continue;
-    std::vector<std::pair<size_t, size_t>> stack{{0, L - 1}};
-    size_t added = 0;
-    while (!stack.empty()) {
-      auto [i, j] = stack.back();
-      stack.pop_back();
-      if (j - i < 2)
-        continue;
-      size_t k = split[i * L + j];
-      res.push_back(loop[i]);
-      res.push_back(loop[k]);
-      res.push_back(loop[j]);
-      if (k - i > 1)
-        chords.insert(edge_key(loop[i], loop[k]));
-      if (j - k > 1)
-        chords.insert(edge_key(loop[k], loop[j]));
-      ++added;
-      stack.push_back({i, k});
-      stack.push_back({k, j});
     }
+    const size_t added = (res.size() - before) / 3;
     ++diag.holes_filled;
     diag.hole_triangles += added;
   }
@@ -898,7 +996,7 @@ double dist2(const double *x, const double *y) {
 } // namespace
 
 void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
-                       size_t min_triangles) {
+                       size_t min_triangles, bool open_too) {
   const size_t nt = tris.size() / 3;
   // describe() keeps no per-triangle component, so count them again.
   std::vector<std::pair<uint64_t, uint32_t>> edges;
@@ -918,7 +1016,8 @@ void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
   std::vector<uint32_t> res;
   res.reserve(tris.size());
   for (size_t t = 0; t < nt; ++t)
-    if (!s.in_closed[t] || count[uf.find(uint32_t(t))] >= min_triangles)
+    if ((!s.in_closed[t] && !open_too) ||
+        count[uf.find(uint32_t(t))] >= min_triangles)
       res.insert(res.end(), &tris[3 * t], &tris[3 * t] + 3);
   tris.swap(res);
 }
