@@ -7,6 +7,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <getopt.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -33,6 +34,72 @@ static const char *const mode_names[SC_MODE_COUNT_] = {
     [SC_MODE_WATERTIGHT] = "watertight",
     [SC_MODE_AUTO] = "auto",
 };
+
+void sc_cli_job_init(sc_cli_job_opts_t *o) {
+  memset(o, 0, sizeof *o);
+  sc_params_init(&o->params);
+  o->normals = 1;
+}
+
+int sc_cli_job_option(sc_cli_job_opts_t *o, int c, const char *arg) {
+  double v;
+  switch (c) {
+  case 'o':
+    o->out_path = arg;
+    return 1;
+  case 'm':
+    return sc_cli_parse_mode("--mode", arg, &o->params.mode) < 0 ? -1 : 1;
+  case SC_CLI_OPT_R:
+    return sc_cli_parse_double("--r", arg, &o->params.r) < 0 ? -1 : 1;
+  case SC_CLI_OPT_THETA:
+    if (sc_cli_parse_double("--theta", arg, &v) < 0)
+      return -1;
+    o->params.cocone_theta = v * SC_PI / 180;
+    return 1;
+  case SC_CLI_OPT_REPORT:
+    o->report = arg;
+    return 1;
+  case SC_CLI_OPT_ASCII:
+    o->ascii = 1;
+    return 1;
+  case SC_CLI_OPT_NO_NORMALS:
+    o->normals = 0;
+    return 1;
+  case 'q':
+    o->quiet = 1;
+    return 1;
+  default:
+    return 0;
+  }
+}
+
+int sc_cli_bad_option(const char *cmd, int c, char **argv) {
+  if (c == ':')
+    sc_cli_error("%s: %s needs a value", cmd, argv[optind - 1]);
+  else
+    sc_cli_error("%s: unknown option '%s' (see shortcrust %s --help)", cmd,
+                 argv[optind - 1], cmd);
+  return SC_EXIT_USAGE;
+}
+
+int sc_cli_job_files(const char *cmd, sc_cli_job_opts_t *o, int argc,
+                     char **argv) {
+  if (optind >= argc) {
+    sc_cli_error("%s: no input file (see shortcrust %s --help)", cmd, cmd);
+    return -1;
+  }
+  if (optind + 1 < argc) {
+    sc_cli_error("%s: one input file expected, got '%s' too", cmd,
+                 argv[optind + 1]);
+    return -1;
+  }
+  o->in_path = argv[optind];
+  if (!o->out_path) {
+    sc_cli_error("%s: no output file: give -o OUT", cmd);
+    return -1;
+  }
+  return 0;
+}
 
 const char *sc_cli_mode_name(sc_mode_t mode) {
   if ((int)mode < 0 || mode >= SC_MODE_COUNT_ || !mode_names[mode])

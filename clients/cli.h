@@ -17,6 +17,8 @@
 
 #include "shortcrust.h"
 
+#define SC_PI 3.14159265358979323846
+
 /* Exit codes of every subcommand. */
 enum {
   SC_EXIT_OK = 0,      /* the job was done */
@@ -33,6 +35,51 @@ int sc_cli_parse_mode(const char *opt, const char *arg, sc_mode_t *out);
 int sc_cli_parse_double(const char *opt, const char *arg, double *out);
 int sc_cli_parse_int(const char *opt, const char *arg, long min, long max,
                      long *out);
+
+/*
+ * The options every mesh-producing subcommand takes: -o, -m, --r, --theta,
+ * --report, --ascii, --no-normals, -q. A subcommand lists
+ * SC_CLI_JOB_LONG_OPTIONS in its getopt_long table (and "o:m:q" in its short
+ * options), numbers its own long options from SC_CLI_OPT_OWN, and passes
+ * each getopt_long result to sc_cli_job_option() first.
+ */
+typedef struct sc_cli_job_opts {
+  sc_params_t params;
+  const char *in_path, *out_path, *report;
+  int quiet, ascii, normals;
+} sc_cli_job_opts_t;
+
+enum {
+  SC_CLI_OPT_R = 256,
+  SC_CLI_OPT_THETA,
+  SC_CLI_OPT_REPORT,
+  SC_CLI_OPT_ASCII,
+  SC_CLI_OPT_NO_NORMALS,
+  SC_CLI_OPT_OWN
+};
+
+#define SC_CLI_JOB_LONG_OPTIONS                                              \
+  {"output", required_argument, NULL, 'o'},                                  \
+      {"mode", required_argument, NULL, 'm'},                                \
+      {"r", required_argument, NULL, SC_CLI_OPT_R},                          \
+      {"theta", required_argument, NULL, SC_CLI_OPT_THETA},                  \
+      {"report", required_argument, NULL, SC_CLI_OPT_REPORT},                \
+      {"ascii", no_argument, NULL, SC_CLI_OPT_ASCII},                        \
+      {"no-normals", no_argument, NULL, SC_CLI_OPT_NO_NORMALS},              \
+      {"quiet", no_argument, NULL, 'q'}
+
+/* The defaults: the core's parameters, normals on. */
+void sc_cli_job_init(sc_cli_job_opts_t *o);
+/* Takes one getopt_long result: 1 when it was a shared option, 0 when it
+ * is not one, -1 (after a message) when its value is bad. */
+int sc_cli_job_option(sc_cli_job_opts_t *o, int c, const char *arg);
+/* Reports a getopt_long error (':' for a missing value, anything else an
+ * unknown option) for subcommand cmd; returns SC_EXIT_USAGE. */
+int sc_cli_bad_option(const char *cmd, int c, char **argv);
+/* After the options: exactly one input file, and -o. Returns 0, or prints
+ * what is missing and returns -1. */
+int sc_cli_job_files(const char *cmd, sc_cli_job_opts_t *o, int argc,
+                     char **argv);
 
 /* The name of a mode as the --mode option spells it. */
 const char *sc_cli_mode_name(sc_mode_t mode);

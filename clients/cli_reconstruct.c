@@ -15,8 +15,6 @@
 #include "cli_commands.h"
 #include "files.h"
 
-#define SC_PI 3.14159265358979323846
-
 static void usage(FILE *f) {
   sc_params_t d;
   sc_params_init(&d);
@@ -64,67 +62,47 @@ static void usage(FILE *f) {
       d.threads);
 }
 
-enum { OPT_R = 256, OPT_THETA, OPT_MAX_HOLE, OPT_PAPER, OPT_REPORT, OPT_ASCII,
-       OPT_NO_NORMALS, OPT_RHO, OPT_ALPHA };
+enum { OPT_MAX_HOLE = SC_CLI_OPT_OWN, OPT_PAPER, OPT_RHO, OPT_ALPHA };
 
 static const struct option long_options[] = {
-    {"output", required_argument, NULL, 'o'},
-    {"mode", required_argument, NULL, 'm'},
-    {"r", required_argument, NULL, OPT_R},
-    {"theta", required_argument, NULL, OPT_THETA},
+    SC_CLI_JOB_LONG_OPTIONS,
     {"max-hole", required_argument, NULL, OPT_MAX_HOLE},
     {"paper-pruning", no_argument, NULL, OPT_PAPER},
     {"rho", required_argument, NULL, OPT_RHO},
     {"alpha", required_argument, NULL, OPT_ALPHA},
     {"threads", required_argument, NULL, 'j'},
-    {"report", required_argument, NULL, OPT_REPORT},
-    {"ascii", no_argument, NULL, OPT_ASCII},
-    {"no-normals", no_argument, NULL, OPT_NO_NORMALS},
-    {"quiet", no_argument, NULL, 'q'},
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
 };
 
 int sc_cmd_reconstruct(int argc, char **argv) {
-  sc_params_t params;
-  sc_params_init(&params);
-  const char *out_path = NULL, *report = NULL;
-  int quiet = 0, ascii = 0, normals = 1;
+  sc_cli_job_opts_t o;
+  sc_cli_job_init(&o);
+  sc_params_t *params = &o.params;
   long l;
   double v;
 
   opterr = 0;
   int c;
   while ((c = getopt_long(argc, argv, ":o:m:j:qh", long_options, NULL)) != -1) {
+    int shared = sc_cli_job_option(&o, c, optarg);
+    if (shared < 0)
+      return SC_EXIT_USAGE;
+    if (shared > 0)
+      continue;
     switch (c) {
-    case 'o':
-      out_path = optarg;
-      break;
-    case 'm':
-      if (sc_cli_parse_mode("--mode", optarg, &params.mode) < 0)
-        return SC_EXIT_USAGE;
-      break;
-    case OPT_R:
-      if (sc_cli_parse_double("--r", optarg, &params.r) < 0)
-        return SC_EXIT_USAGE;
-      break;
-    case OPT_THETA:
-      if (sc_cli_parse_double("--theta", optarg, &v) < 0)
-        return SC_EXIT_USAGE;
-      params.cocone_theta = v * SC_PI / 180;
-      break;
     case OPT_MAX_HOLE:
       if (sc_cli_parse_int("--max-hole", optarg, 0, 100000, &l) < 0)
         return SC_EXIT_USAGE;
-      params.max_hole_edges = (int)l;
+      params->max_hole_edges = (int)l;
       break;
     case OPT_PAPER:
-      params.paper_pruning = 1;
+      params->paper_pruning = 1;
       break;
     case OPT_RHO:
-      if (sc_cli_parse_double("--rho", optarg, &params.boundary_rho) < 0)
+      if (sc_cli_parse_double("--rho", optarg, &params->boundary_rho) < 0)
         return SC_EXIT_USAGE;
-      if (!(params.boundary_rho > 0)) {
+      if (!(params->boundary_rho > 0)) {
         sc_cli_error("--rho: must be positive, got %s", optarg);
         return SC_EXIT_USAGE;
       }
@@ -136,65 +114,35 @@ int sc_cmd_reconstruct(int argc, char **argv) {
         sc_cli_error("--alpha: must be positive, got %s", optarg);
         return SC_EXIT_USAGE;
       }
-      params.boundary_alpha = v * SC_PI / 180;
+      params->boundary_alpha = v * SC_PI / 180;
       break;
     case 'j':
       if (sc_cli_parse_int("--threads", optarg, 0, 1024, &l) < 0)
         return SC_EXIT_USAGE;
-      params.threads = (int)l;
-      break;
-    case OPT_REPORT:
-      report = optarg;
-      break;
-    case OPT_ASCII:
-      ascii = 1;
-      break;
-    case OPT_NO_NORMALS:
-      normals = 0;
-      break;
-    case 'q':
-      quiet = 1;
+      params->threads = (int)l;
       break;
     case 'h':
       usage(stdout);
       return SC_EXIT_OK;
-    case ':':
-      sc_cli_error("reconstruct: %s needs a value", argv[optind - 1]);
-      return SC_EXIT_USAGE;
     default:
-      sc_cli_error("reconstruct: unknown option '%s' (see shortcrust "
-                   "reconstruct --help)",
-                   argv[optind - 1]);
-      return SC_EXIT_USAGE;
+      return sc_cli_bad_option("reconstruct", c, argv);
     }
   }
-  if (optind >= argc) {
-    sc_cli_error("reconstruct: no input file (see shortcrust reconstruct "
-                 "--help)");
+  if (sc_cli_job_files("reconstruct", &o, argc, argv) < 0)
     return SC_EXIT_USAGE;
-  }
-  if (optind + 1 < argc) {
-    sc_cli_error("reconstruct: one input file expected, got '%s' too",
-                 argv[optind + 1]);
-    return SC_EXIT_USAGE;
-  }
-  const char *in_path = argv[optind];
-  if (!out_path) {
-    sc_cli_error("reconstruct: no output file: give -o OUT");
-    return SC_EXIT_USAGE;
-  }
+  const char *in_path = o.in_path, *out_path = o.out_path;
 
   char msg[1024];
   sc_mesh_format_t fmt;
-  if (sc_mesh_format_from_path(out_path, ascii, &fmt, msg, sizeof msg) < 0) {
+  if (sc_mesh_format_from_path(out_path, o.ascii, &fmt, msg, sizeof msg) < 0) {
     sc_cli_error("%s", msg);
     return SC_EXIT_USAGE;
   }
 
   sc_cli_progress_t progress;
-  sc_cli_progress_init(&progress, quiet);
-  params.progress = sc_cli_progress_fn;
-  params.progress_user = &progress;
+  sc_cli_progress_init(&progress, o.quiet);
+  params->progress = sc_cli_progress_fn;
+  params->progress_user = &progress;
 
   double t0 = sc_cli_now();
   sc_cli_progress_step(&progress, "reading", 0);
@@ -207,7 +155,7 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   double t_read = sc_cli_now() - t0;
 
   sc_mesh_t *mesh = NULL;
-  int rc = sc_reconstruct(pts.xyz, pts.count, &params, &mesh, msg, sizeof msg);
+  int rc = sc_reconstruct(pts.xyz, pts.count, params, &mesh, msg, sizeof msg);
   if (rc < 0) {
     sc_cli_progress_done(&progress);
     sc_points_free(&pts);
@@ -223,7 +171,7 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   sc_cli_progress_step(&progress, "writing", 0);
   t0 = sc_cli_now();
   rc = sc_mesh_write(out_path, fmt, pts.xyz, pts.count, mesh->triangles,
-                     mesh->triangle_count, normals ? mesh->normals : NULL, msg,
+                     mesh->triangle_count, o.normals ? mesh->normals : NULL, msg,
                      sizeof msg);
   double t_write = sc_cli_now() - t0;
   sc_cli_progress_done(&progress);
@@ -236,16 +184,16 @@ int sc_cmd_reconstruct(int argc, char **argv) {
         .command = "reconstruct",
         .input = in_path,
         .output = out_path,
-        .params = params,
+        .params = *params,
         .diag = &mesh->diag,
         .component_genus = mesh->component_genus,
         .component_count = mesh->component_count,
         .seconds_read = t_read,
         .seconds_write = t_write,
     };
-    if (report && sc_cli_write_report(report, &res) < 0)
+    if (o.report && sc_cli_write_report(o.report, &res) < 0)
       status = SC_EXIT_FAILURE;
-    if (!quiet)
+    if (!o.quiet)
       sc_cli_summary(stdout, &res);
   }
   sc_mesh_free(mesh);

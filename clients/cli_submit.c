@@ -18,8 +18,6 @@
 #include "files.h"
 #include "shortcrust_client.h"
 
-#define SC_PI 3.14159265358979323846
-
 static void usage(FILE *f) {
   sc_params_t d;
   sc_params_init(&d);
@@ -58,25 +56,11 @@ static void usage(FILE *f) {
       sc_client_default_socket(sock, sizeof sock));
 }
 
-enum {
-  OPT_R = 256,
-  OPT_THETA,
-  OPT_SOCKET,
-  OPT_REPORT,
-  OPT_ASCII,
-  OPT_NO_NORMALS
-};
+enum { OPT_SOCKET = SC_CLI_OPT_OWN };
 
 static const struct option long_options[] = {
-    {"output", required_argument, NULL, 'o'},
-    {"mode", required_argument, NULL, 'm'},
-    {"r", required_argument, NULL, OPT_R},
-    {"theta", required_argument, NULL, OPT_THETA},
+    SC_CLI_JOB_LONG_OPTIONS,
     {"socket", required_argument, NULL, OPT_SOCKET},
-    {"report", required_argument, NULL, OPT_REPORT},
-    {"ascii", no_argument, NULL, OPT_ASCII},
-    {"no-normals", no_argument, NULL, OPT_NO_NORMALS},
-    {"quiet", no_argument, NULL, 'q'},
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
 };
@@ -165,76 +149,36 @@ static void diag_from_values(const sc_client_mesh_t *m, sc_diag_t *d) {
 }
 
 int sc_cmd_submit(int argc, char **argv) {
+  sc_cli_job_opts_t o;
+  sc_cli_job_init(&o);
   sc_params_t params;
-  sc_params_init(&params);
   /* The daemon's reconstruction runs on one thread. */
-  params.threads = 1;
-  const char *out_path = NULL, *report = NULL, *socket_path = NULL;
-  int quiet = 0, ascii = 0, normals = 1;
-  double v;
+  o.params.threads = 1;
+  const char *socket_path = NULL;
 
   opterr = 0;
   int c;
   while ((c = getopt_long(argc, argv, ":o:m:qh", long_options, NULL)) != -1) {
+    int shared = sc_cli_job_option(&o, c, optarg);
+    if (shared < 0)
+      return SC_EXIT_USAGE;
+    if (shared > 0)
+      continue;
     switch (c) {
-    case 'o':
-      out_path = optarg;
-      break;
-    case 'm':
-      if (sc_cli_parse_mode("--mode", optarg, &params.mode) < 0)
-        return SC_EXIT_USAGE;
-      break;
-    case OPT_R:
-      if (sc_cli_parse_double("--r", optarg, &params.r) < 0)
-        return SC_EXIT_USAGE;
-      break;
-    case OPT_THETA:
-      if (sc_cli_parse_double("--theta", optarg, &v) < 0)
-        return SC_EXIT_USAGE;
-      params.cocone_theta = v * SC_PI / 180;
-      break;
     case OPT_SOCKET:
       socket_path = optarg;
-      break;
-    case OPT_REPORT:
-      report = optarg;
-      break;
-    case OPT_ASCII:
-      ascii = 1;
-      break;
-    case OPT_NO_NORMALS:
-      normals = 0;
-      break;
-    case 'q':
-      quiet = 1;
       break;
     case 'h':
       usage(stdout);
       return SC_EXIT_OK;
-    case ':':
-      sc_cli_error("submit: %s needs a value", argv[optind - 1]);
-      return SC_EXIT_USAGE;
     default:
-      sc_cli_error("submit: unknown option '%s' (see shortcrust submit "
-                   "--help)",
-                   argv[optind - 1]);
-      return SC_EXIT_USAGE;
+      return sc_cli_bad_option("submit", c, argv);
     }
   }
-  if (optind >= argc) {
-    sc_cli_error("submit: no input file (see shortcrust submit --help)");
+  if (sc_cli_job_files("submit", &o, argc, argv) < 0)
     return SC_EXIT_USAGE;
-  }
-  if (optind + 1 < argc) {
-    sc_cli_error("submit: one input file expected, got '%s' too",
-                 argv[optind + 1]);
-    return SC_EXIT_USAGE;
-  }
-  const char *in_path = argv[optind];
-  if (!out_path) {
-    sc_cli_error("submit: no output file: give -o OUT");
-    return SC_EXIT_USAGE;
-  }
+  params = o.params;
+  const char *in_path = o.in_path, *out_path = o.out_path;
   /* Checked here, before any file or the daemon is touched, and worded as
    * `reconstruct` words them. */
   if (!(params.r > 0 && params.r < 0.5)) {
@@ -249,13 +193,13 @@ int sc_cmd_submit(int argc, char **argv) {
 
   char msg[1024];
   sc_mesh_format_t fmt;
-  if (sc_mesh_format_from_path(out_path, ascii, &fmt, msg, sizeof msg) < 0) {
+  if (sc_mesh_format_from_path(out_path, o.ascii, &fmt, msg, sizeof msg) < 0) {
     sc_cli_error("%s", msg);
     return SC_EXIT_USAGE;
   }
 
   sc_cli_progress_t progress;
-  sc_cli_progress_init(&progress, quiet);
+  sc_cli_progress_init(&progress, o.quiet);
 
   double t0 = sc_cli_now();
   sc_cli_progress_step(&progress, "reading", 0);
@@ -285,7 +229,7 @@ int sc_cmd_submit(int argc, char **argv) {
   cp.r = params.r;
   cp.theta = params.cocone_theta;
   /* As doubles, so that the file gets what the local command writes. */
-  cp.normals = normals;
+  cp.normals = o.normals;
   cp.progress = show_progress;
   cp.progress_user = &progress;
   sc_client_job_t *job = NULL;
@@ -317,7 +261,7 @@ int sc_cmd_submit(int argc, char **argv) {
   sc_cli_progress_step(&progress, "writing", 0);
   t0 = sc_cli_now();
   rc = sc_mesh_write(out_path, fmt, pts.xyz, pts.count, mesh.triangles,
-                     (size_t)mesh.triangle_count, normals ? mesh.normals : NULL,
+                     (size_t)mesh.triangle_count, o.normals ? mesh.normals : NULL,
                      msg, sizeof msg);
   double t_write = sc_cli_now() - t0;
   sc_cli_progress_done(&progress);
@@ -339,9 +283,9 @@ int sc_cmd_submit(int argc, char **argv) {
         .seconds_write = t_write,
         .seconds_transfer = transfer,
     };
-    if (report && sc_cli_write_report(report, &res) < 0)
+    if (o.report && sc_cli_write_report(o.report, &res) < 0)
       status = SC_EXIT_FAILURE;
-    if (!quiet)
+    if (!o.quiet)
       sc_cli_summary(stdout, &res);
   }
   sc_client_job_free(job);
