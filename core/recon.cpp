@@ -102,12 +102,14 @@ void canonical_order(std::vector<uint32_t> &tris) {
 } // namespace
 
 // Watertight mode, after extraction: closes the open components of surf.
-// Two closures are made and the better one kept (see Closure): labelling
-// the Delaunay cells across the surface, which closes holes of any size;
-// and least-area patches over each loop, which keep the surface as it is
-// but fail on loops too long for the dynamic programme. Closed components
-// take no part in the labelling (two nested spheres would otherwise vote
-// against each other) and are added back as they are.
+// First the least-area patches over each loop, which keep the surface as
+// it is; if they leave a closed manifold, that is the result. Otherwise the
+// Delaunay cells are labelled across the surface, which closes holes of any
+// size, and the better of the two closures is kept (see Closure). On the
+// bunny scans the patches won every time, with a lower genus and in a
+// fraction of the time. Closed components take no part in the labelling
+// (two nested spheres would otherwise vote against each other) and are
+// added back as they are.
 void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
                           Surface &surf, sc_diag_t &diag) {
   const uint64_t loops = diag.boundary_loops, before = diag.triangles;
@@ -121,40 +123,46 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
     diag.path = SC_PATH_WATERTIGHT;
     return;
   }
-  std::vector<uint32_t> extracted = surf.tris, labelled = open;
-  const bool have_labels = dt_->close(labelled, progress, diag);
-  canonical_order(labelled);
-  dt_.reset();
-  const uint64_t relabelled = diag.cells_relabelled;
+  // Debris, such as lone triangles between scan layers, cannot be closed:
+  // small open components go (their samples may be attached later).
+  auto drop_debris = [&](Surface &s, sc_diag_t &d) {
+    if (!d.closed && d.components > 1 && !s.tris.empty()) {
+      drop_small_closed(s.tris, s,
+                        std::max<size_t>(kMinBubble, s.tris.size() / 3 / 1000),
+                        true);
+      describe(lxyz, m, s.tris, progress, s, d);
+    }
+  };
+
+  Surface b;
+  sc_diag_t db = diag;
+  describe(lxyz, m, surf.tris, progress, b, db);
+  fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork);
+  describe(lxyz, m, b.tris, progress, b, db);
+  drop_debris(b, db);
 
   Surface a;
   sc_diag_t da = diag;
-  if (have_labels) {
-    labelled.insert(labelled.end(), closed_part.begin(), closed_part.end());
-    describe(lxyz, m, labelled, progress, a, da);
-    if (da.nonmanifold_edges || da.nonmanifold_vertices) {
-      // Relabelling left a few pinches: cut them out and close the small
-      // holes that leaves.
-      drop_nonmanifold(lxyz, m, a.tris, progress);
-      fill_holes(lxyz, m, a.tris, kMaxFillLoop, {}, progress, da);
-      describe(lxyz, m, a.tris, progress, a, da);
+  bool have_labels = false;
+  if (!Closure(db).ok) {
+    std::vector<uint32_t> labelled = open;
+    have_labels = dt_->close(labelled, progress, da);
+    canonical_order(labelled);
+    if (have_labels) {
+      labelled.insert(labelled.end(), closed_part.begin(), closed_part.end());
+      describe(lxyz, m, labelled, progress, a, da);
+      if (da.nonmanifold_edges || da.nonmanifold_vertices) {
+        // Relabelling left a few pinches: cut them out and close the small
+        // holes that leaves.
+        drop_nonmanifold(lxyz, m, a.tris, progress);
+        fill_holes(lxyz, m, a.tris, kMaxFillLoop, {}, progress, da);
+        describe(lxyz, m, a.tris, progress, a, da);
+      }
+      drop_debris(a, da);
     }
   }
-  Surface b;
-  sc_diag_t db = diag;
-  describe(lxyz, m, extracted, progress, b, db);
-  fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork);
-  describe(lxyz, m, b.tris, progress, b, db);
-  // Debris, such as lone triangles between scan layers, cannot be closed:
-  // small open components go from both closures (their samples may be
-  // attached later).
-  for (auto [s, d] : {std::pair<Surface *, sc_diag_t *>{&a, &da}, {&b, &db}})
-    if (!d->closed && d->components > 1 && !s->tris.empty()) {
-      drop_small_closed(s->tris, *s,
-                        std::max<size_t>(kMinBubble, s->tris.size() / 3 / 1000),
-                        true);
-      describe(lxyz, m, s->tris, progress, *s, *d);
-    }
+  dt_.reset();
+  const uint64_t relabelled = da.cells_relabelled;
 
   if (have_labels && !Closure(db).better_than(Closure(da))) {
     surf = std::move(a);
