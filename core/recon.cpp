@@ -304,13 +304,17 @@ sc_mesh_t *Recon::finish() {
     const uint64_t closed_before = diag.closed_components;
     drop_small_closed(surf.tris, surf,
                       std::max<size_t>(kMinBubble, before / 1000));
-    describe(lxyz.data(), m, surf.tris, progress, surf, diag);
+    // describe() is a pass over the whole surface: skip it where nothing
+    // changed since the last one.
+    if (surf.tris.size() / 3 != before)
+      describe(lxyz.data(), m, surf.tris, progress, surf, diag);
     diag.bubbles_dropped =
         closed_before - std::min(closed_before, diag.closed_components);
     if (watertight)
       close_surface(lxyz.data(), m, progress, surf, diag);
     diag.samples_attached = attach_samples(lxyz.data(), m, surf.tris, progress);
-    describe(lxyz.data(), m, surf.tris, progress, surf, diag);
+    if (diag.samples_attached)
+      describe(lxyz.data(), m, surf.tris, progress, surf, diag);
   }
 
   // Per-vertex normals: the pole direction, signed to agree with the

@@ -35,6 +35,7 @@ struct EdgeTable {
     uint64_t key;
     double angle;
     uint32_t tri;
+    uint8_t corner; // the edge is (v[corner], v[corner + 1]) of tri
   };
   std::vector<Entry> entries;   // grouped by edge, each group by angle
   std::vector<uint32_t> first;  // edge id -> first entry; one extra at end
@@ -42,8 +43,11 @@ struct EdgeTable {
 
   size_t edges() const { return first.size() - 1; }
 
+  // Without `angles`, the triangles of an edge come in the order of their
+  // numbers and Entry::angle is 0: enough for finding edges and their
+  // triangles, and it saves an atan2 per corner.
   void build(const double *xyz, size_t n, const std::vector<uint32_t> &tris,
-             Progress &progress) {
+             Progress &progress, bool angles = true) {
     const size_t nt = tris.size() / 3;
     // Bucket the entries by their smaller vertex (a counting sort), then
     // sort each small bucket: linear overall, unlike one global sort.
@@ -62,14 +66,17 @@ struct EdgeTable {
         uint32_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3],
                  c = tris[3 * t + (k + 2) % 3];
         uint32_t lo = std::min(a, b), hi = std::max(a, b);
-        entries[fill[lo]++] = {edge_key(a, b), angle(xyz, lo, hi, c),
-                               uint32_t(t)};
+        entries[fill[lo]++] = {edge_key(a, b),
+                               angles ? angle(xyz, lo, hi, c) : 0.0,
+                               uint32_t(t), uint8_t(k)};
       }
     }
     for (size_t v = 0; v < n; ++v)
       std::sort(entries.begin() + count[v], entries.begin() + count[v + 1],
                 [](const Entry &x, const Entry &y) {
-                  return x.key != y.key ? x.key < y.key : x.angle < y.angle;
+                  return x.key != y.key       ? x.key < y.key
+                         : x.angle != y.angle ? x.angle < y.angle
+                                              : x.tri < y.tri;
                 });
     first.clear();
     tri_edge.assign(3 * nt, 0);
@@ -77,11 +84,8 @@ struct EdgeTable {
       progress.tick(nt + i / 3, 2 * nt);
       if (i == 0 || entries[i].key != entries[i - 1].key)
         first.push_back(uint32_t(i));
-      uint32_t e = uint32_t(first.size() - 1), t = entries[i].tri;
-      for (int k = 0; k < 3; ++k)
-        if (edge_key(tris[3 * t + k], tris[3 * t + (k + 1) % 3]) ==
-            entries[i].key)
-          tri_edge[3 * t + k] = e;
+      tri_edge[3 * size_t(entries[i].tri) + entries[i].corner] =
+          uint32_t(first.size() - 1);
     }
     first.push_back(uint32_t(entries.size()));
   }
@@ -403,7 +407,7 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
   if (res.empty())
     return;
   EdgeTable et;
-  et.build(xyz, n, res, progress);
+  et.build(xyz, n, res, progress, false);
   // Chords added by earlier fills count as existing edges too: two holes
   // that share vertices must not both add the same chord.
   std::unordered_set<uint64_t> chords;
@@ -796,7 +800,7 @@ void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                       Progress &progress) {
   const size_t nt = tris.size() / 3;
   EdgeTable et;
-  et.build(xyz, n, tris, progress);
+  et.build(xyz, n, tris, progress, false);
   std::vector<uint8_t> in(nt, 1);
   for (size_t e = 0; e < et.edges(); ++e)
     if (et.first[e + 1] - et.first[e] > 2)
@@ -822,7 +826,7 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
   std::vector<int> fan_of;
   const size_t nr = res.size() / 3;
   EdgeTable rt;
-  rt.build(xyz, n, res, progress);
+  rt.build(xyz, n, res, progress, false);
   UnionFind uf(nr);
   for (size_t e = 0; e < rt.edges(); ++e)
     for (uint32_t i = rt.first[e] + 1; i < rt.first[e + 1]; ++i)
