@@ -932,23 +932,35 @@ static void bad_job_frame(scd_conn_t *c, const scp_frame_t *f, int rc) {
   }
 }
 
+/* A job frame's payload did not parse: a fatal error closes the
+ * connection, any other is answered for the job the frame names. */
+static void job_frame_failed(scd_conn_t *c, const scp_frame_t *f, int rc) {
+  if (scp_err_is_fatal(rc))
+    protocol_fatal(c, rc, 0, f->type);
+  else
+    bad_job_frame(c, f, rc);
+}
+
+/* The connection's job `id`, or NULL after answering UNKNOWN_JOB. */
+static scd_job_t *known_job(scd_conn_t *c, const scp_frame_t *f,
+                            uint32_t id) {
+  scd_job_t *j = find_job(c, id);
+  if (!j)
+    reply_error(c, SCP_WIRE_UNKNOWN_JOB, id, f->type, "no job %u", id);
+  return j;
+}
+
 static void on_points(scd_conn_t *c, const scp_frame_t *f) {
   scd_server_t *srv = c->srv;
   scp_chunk_t ch;
   int rc = scp_parse_chunk(f, &ch);
   if (rc != 0) {
-    if (scp_err_is_fatal(rc))
-      protocol_fatal(c, rc, 0, f->type);
-    else
-      bad_job_frame(c, f, rc);
+    job_frame_failed(c, f, rc);
     return;
   }
-  scd_job_t *j = find_job(c, ch.job_id);
-  if (!j) {
-    reply_error(c, SCP_WIRE_UNKNOWN_JOB, ch.job_id, f->type, "no job %u",
-                ch.job_id);
+  scd_job_t *j = known_job(c, f, ch.job_id);
+  if (!j)
     return;
-  }
   if (j->phase == SCD_JOB_DRAINING)
     return;
   if (j->phase != SCD_JOB_UPLOADING) {
@@ -1005,18 +1017,12 @@ static void on_job_end(scd_conn_t *c, const scp_frame_t *f) {
   scp_job_end_t m;
   int rc = scp_parse_job_end(f, &m);
   if (rc != 0) {
-    if (scp_err_is_fatal(rc))
-      protocol_fatal(c, rc, 0, f->type);
-    else
-      bad_job_frame(c, f, rc);
+    job_frame_failed(c, f, rc);
     return;
   }
-  scd_job_t *j = find_job(c, m.job_id);
-  if (!j) {
-    reply_error(c, SCP_WIRE_UNKNOWN_JOB, m.job_id, f->type, "no job %u",
-                m.job_id);
+  scd_job_t *j = known_job(c, f, m.job_id);
+  if (!j)
     return;
-  }
   if (j->phase == SCD_JOB_DRAINING) {
     free_job(c, j);
     return;
@@ -1046,10 +1052,7 @@ static void on_cancel(scd_conn_t *c, const scp_frame_t *f) {
   uint32_t id;
   int rc = scp_parse_cancel(f, &id);
   if (rc != 0) {
-    if (scp_err_is_fatal(rc))
-      protocol_fatal(c, rc, 0, f->type);
-    else
-      bad_job_frame(c, f, rc);
+    job_frame_failed(c, f, rc);
     return;
   }
   scd_job_t *j = find_job(c, id);

@@ -269,6 +269,30 @@ double *scdt_sample_random(int surface, size_t n, uint64_t seed) {
   return sample(surface, SC_DENSITY_UNIFORM_RANDOM, n, seed);
 }
 
+void scdt_run_ok(scdt_conn_t *c, uint32_t id, int surface, const double *xyz,
+                 size_t n, int timeout_ms, const char *when) {
+  scdt_job_t j;
+  scdt_job_init(&j, id, xyz, n);
+  scdt_job_t *pj = &j;
+  char why[512] = "";
+  CHECK(scdt_job_send(c, &j) == 0, "%s: send", when);
+  CHECK(scdt_collect(c, &pj, 1, timeout_ms, why, sizeof why) == 0, "%s: %s",
+        when, why);
+  CHECK(scdt_mesh_ok(surface, &j, why, sizeof why), "%s: %s", when, why);
+  scdt_job_reset(&j);
+}
+
+void scdt_check_serving(const char *sock, int surface, const double *xyz,
+                        size_t n, int timeout_ms, const char *when) {
+  scdt_conn_t *c;
+  int rc = scdt_open(sock, 1u << 20, &c);
+  CHECK(rc == 0, "%s: cannot connect: %d", when, rc);
+  if (rc != 0)
+    return;
+  scdt_run_ok(c, 1, surface, xyz, n, timeout_ms, when);
+  scdt_close(c);
+}
+
 int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {
   if (!j->done) {
     snprintf(why, len, "job %u did not finish: error %s: %s", j->id,

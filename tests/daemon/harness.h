@@ -105,6 +105,14 @@ double *scdt_sample_random(int surface, size_t n, uint64_t seed);
  * with the reason in why. */
 int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len);
 
+/* Runs the n points as job `id` on c and checks, recording any failure,
+ * that a correct mesh of `surface` comes back; `when` heads the messages. */
+void scdt_run_ok(scdt_conn_t *c, uint32_t id, int surface, const double *xyz,
+                 size_t n, int timeout_ms, const char *when);
+/* The same on a fresh connection to sock: the daemon still serves. */
+void scdt_check_serving(const char *sock, int surface, const double *xyz,
+                        size_t n, int timeout_ms, const char *when);
+
 /* 1 when job j came back as a closed, oriented 2-manifold over its own
  * points, whatever its genus; otherwise 0 with the reason in why. */
 int scdt_mesh_closed(const scdt_job_t *j, char *why, size_t len);

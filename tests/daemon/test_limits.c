@@ -22,26 +22,11 @@ static scdt_daemon_t d;
 static double *sphere;   /* 4000 points */
 
 static void run_ok(scdt_conn_t *c, uint32_t id, const char *when) {
-  scdt_job_t j;
-  scdt_job_init(&j, id, sphere, 4000);
-  scdt_job_t *pj = &j;
-  char why[512] = "";
-  CHECK(scdt_job_send(c, &j) == 0, "%s: send", when);
-  CHECK(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s: %s", when,
-        why);
-  CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &j, why, sizeof why), "%s: %s", when,
-        why);
-  scdt_job_reset(&j);
+  scdt_run_ok(c, id, SC_SURF_SPHERE, sphere, 4000, T_MS, when);
 }
 
 static void check_serving(const char *when) {
-  scdt_conn_t *c;
-  int rc = scdt_open(d.sock, 1u << 20, &c);
-  CHECK(rc == 0, "%s: cannot connect: %d", when, rc);
-  if (rc != 0)
-    return;
-  run_ok(c, 1, when);
-  scdt_close(c);
+  scdt_check_serving(d.sock, SC_SURF_SPHERE, sphere, 4000, T_MS, when);
 }
 
 /* Collects one job that must fail with the code; `other`, when not NULL,

@@ -65,21 +65,10 @@ static uint64_t flood(scdt_conn_t *c) {
 }
 
 static void check_serving(const char *when) {
-  scdt_conn_t *c;
-  REQUIRE(scdt_open(d.sock, 1u << 20, &c) == 0, "%s: cannot connect", when);
   double *xyz = scdt_sample(SC_SURF_TORUS, 3000, 42);
-  scdt_job_t j;
-  scdt_job_init(&j, 1, xyz, 3000);
-  scdt_job_t *pj = &j;
-  char why[512] = "";
-  CHECK(scdt_job_send(c, &j) == 0, "%s: send", when);
-  CHECK(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s: %s", when,
-        why);
-  CHECK(scdt_mesh_ok(SC_SURF_TORUS, &j, why, sizeof why), "%s: %s", when,
-        why);
-  scdt_job_reset(&j);
+  REQUIRE(xyz != NULL, "%s: sample", when);
+  scdt_check_serving(d.sock, SC_SURF_TORUS, xyz, 3000, T_MS, when);
   free(xyz);
-  scdt_close(c);
 }
 
 static void check_bounded(const char *when) {
