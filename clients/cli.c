@@ -41,6 +41,31 @@ void sc_cli_job_init(sc_cli_job_opts_t *o) {
   o->normals = 1;
 }
 
+void sc_cli_job_usage_params(FILE *f) {
+  sc_params_t d;
+  sc_params_init(&d);
+  fprintf(f,
+          "  -o, --output OUT      the mesh to write (required)\n"
+          "  -m, --mode MODE       cocone, shortcrust, boundary (scans with a "
+          "boundary),\n"
+          "                        watertight (close every hole) or auto "
+          "(default %s)\n"
+          "      --r R             shortcrust sampling parameter, in (0, 0.5) "
+          "(default %g)\n"
+          "      --theta DEG       cocone half-width in degrees, in (0, 90) "
+          "(default %g)\n",
+          sc_cli_mode_name(d.mode), d.r, d.cocone_theta * 180 / SC_PI);
+}
+
+void sc_cli_job_usage_output(FILE *f) {
+  fputs("      --report FILE     write the diagnostics as JSON to FILE\n"
+        "      --ascii           write ascii PLY or STL instead of binary\n"
+        "      --no-normals      do not write per-vertex normals\n"
+        "  -q, --quiet           no progress and no summary; errors only\n"
+        "  -h, --help            this text\n\n",
+        f);
+}
+
 int sc_cli_job_option(sc_cli_job_opts_t *o, int c, const char *arg) {
   double v;
   switch (c) {

@@ -68,6 +68,11 @@ enum {
       {"no-normals", no_argument, NULL, SC_CLI_OPT_NO_NORMALS},              \
       {"quiet", no_argument, NULL, 'q'}
 
+/* The help lines of the shared options: those that choose the job (-o,
+ * -m, --r, --theta, with their defaults), and those about the output
+ * (--report to --help). A subcommand prints its own options between. */
+void sc_cli_job_usage_params(FILE *f);
+void sc_cli_job_usage_output(FILE *f);
 /* The defaults: the core's parameters, normals on. */
 void sc_cli_job_init(sc_cli_job_opts_t *o);
 /* Takes one getopt_long result: 1 when it was a shared option, 0 when it

@@ -18,48 +18,36 @@
 static void usage(FILE *f) {
   sc_params_t d;
   sc_params_init(&d);
-  fprintf(
-      f,
-      "usage: shortcrust reconstruct IN -o OUT [options]\n\n"
-      "Reconstructs a triangle mesh from the points of IN and writes it to\n"
-      "OUT. IN may be .ply (ascii or binary), .xyz/.txt/.pts/.csv, .off or\n"
-      ".obj (a mesh file gives its vertices). OUT's extension picks the\n"
-      "format: .ply (binary unless --ascii), .off, .obj or .stl. Every input\n"
-      "point is written, in input order, so triangle indices refer to IN.\n\n"
-      "options:\n"
-      "  -o, --output OUT      the mesh to write (required)\n"
-      "  -m, --mode MODE       cocone, shortcrust, boundary (scans with a "
-      "boundary),\n"
-      "                        watertight (close every hole) or auto "
-      "(default %s)\n"
-      "      --r R             shortcrust sampling parameter, in (0, 0.5) "
-      "(default %g)\n"
-      "      --theta DEG       cocone half-width in degrees, in (0, 90) "
-      "(default %g)\n"
-      "      --max-hole N      close holes of at most N edges, 0 = never "
-      "(default %d)\n"
-      "      --paper-pruning   prune every edge with a single candidate, as "
-      "in the paper\n"
-      "      --rho RHO         boundary detection: ratio of cocone extent to "
-      "pole height,\n"
-      "                        in (0, 10] (default %g)\n"
-      "      --alpha DEG       boundary detection: largest angle between "
-      "neighbouring\n"
-      "                        poles, in (0, 90] degrees (default %g)\n"
-      "  -j, --threads N       threads for the Delaunay triangulation, 0 = "
-      "one per core\n"
-      "                        (default %d)\n"
-      "      --report FILE     write the diagnostics as JSON to FILE\n"
-      "      --ascii           write ascii PLY or STL instead of binary\n"
-      "      --no-normals      do not write per-vertex normals\n"
-      "  -q, --quiet           no progress and no summary; errors only\n"
-      "  -h, --help            this text\n\n"
-      "Progress goes to stderr when it is a terminal; the summary goes to\n"
-      "stdout. Exit status: 0 done, 1 failed (the message says why), 2 bad\n"
-      "command line.\n",
-      sc_cli_mode_name(d.mode), d.r, d.cocone_theta * 180 / SC_PI,
-      d.max_hole_edges, d.boundary_rho, d.boundary_alpha * 180 / SC_PI,
-      d.threads);
+  fputs("usage: shortcrust reconstruct IN -o OUT [options]\n\n"
+        "Reconstructs a triangle mesh from the points of IN and writes it to\n"
+        "OUT. IN may be .ply (ascii or binary), .xyz/.txt/.pts/.csv, .off or\n"
+        ".obj (a mesh file gives its vertices). OUT's extension picks the\n"
+        "format: .ply (binary unless --ascii), .off, .obj or .stl. Every input\n"
+        "point is written, in input order, so triangle indices refer to IN.\n\n"
+        "options:\n",
+        f);
+  sc_cli_job_usage_params(f);
+  fprintf(f,
+          "      --max-hole N      close holes of at most N edges, 0 = never "
+          "(default %d)\n"
+          "      --paper-pruning   prune every edge with a single candidate, "
+          "as in the paper\n"
+          "      --rho RHO         boundary detection: ratio of cocone extent "
+          "to pole height,\n"
+          "                        in (0, 10] (default %g)\n"
+          "      --alpha DEG       boundary detection: largest angle between "
+          "neighbouring\n"
+          "                        poles, in (0, 90] degrees (default %g)\n"
+          "  -j, --threads N       threads for the Delaunay triangulation, 0 = "
+          "one per core\n"
+          "                        (default %d)\n",
+          d.max_hole_edges, d.boundary_rho, d.boundary_alpha * 180 / SC_PI,
+          d.threads);
+  sc_cli_job_usage_output(f);
+  fputs("Progress goes to stderr when it is a terminal; the summary goes to\n"
+        "stdout. Exit status: 0 done, 1 failed (the message says why), 2 bad\n"
+        "command line.\n",
+        f);
 }
 
 enum { OPT_MAX_HOLE = SC_CLI_OPT_OWN, OPT_PAPER, OPT_RHO, OPT_ALPHA };

@@ -19,41 +19,26 @@
 #include "shortcrust_client.h"
 
 static void usage(FILE *f) {
-  sc_params_t d;
-  sc_params_init(&d);
   char sock[256];
-  fprintf(
-      f,
-      "usage: shortcrust submit IN -o OUT [options]\n\n"
-      "Sends the points of IN to the shortcrust daemon (shortcrustd), which\n"
-      "reconstructs the mesh, and writes the mesh to OUT. Formats, summary\n"
-      "and report are those of `shortcrust reconstruct`, and so are the\n"
-      "triangles for the same input and options. IN may be .ply (ascii or\n"
-      "binary), .xyz/.txt/.pts/.csv, .off or .obj; OUT's extension picks the\n"
-      "format: .ply (binary unless --ascii), .off, .obj or .stl. The daemon\n"
-      "fills holes, prunes and finds boundaries with the defaults of\n"
-      "`reconstruct`, on one thread.\n\n"
-      "options:\n"
-      "  -o, --output OUT      the mesh to write (required)\n"
-      "  -m, --mode MODE       cocone, shortcrust, boundary (scans with a "
-      "boundary),\n"
-      "                        watertight (close every hole) or auto "
-      "(default %s)\n"
-      "      --r R             shortcrust sampling parameter, in (0, 0.5) "
-      "(default %g)\n"
-      "      --theta DEG       cocone half-width in degrees, in (0, 90) "
-      "(default %g)\n"
-      "      --socket PATH     the daemon's socket (default %s)\n"
-      "      --report FILE     write the diagnostics as JSON to FILE\n"
-      "      --ascii           write ascii PLY or STL instead of binary\n"
-      "      --no-normals      do not write per-vertex normals\n"
-      "  -q, --quiet           no progress and no summary; errors only\n"
-      "  -h, --help            this text\n\n"
-      "Progress (upload, each stage on the daemon, download) goes to stderr\n"
-      "when it is a terminal; the summary goes to stdout. Exit status: 0\n"
-      "done, 1 failed (the message says why), 2 bad command line.\n",
-      sc_cli_mode_name(d.mode), d.r, d.cocone_theta * 180 / SC_PI,
-      sc_client_default_socket(sock, sizeof sock));
+  fputs("usage: shortcrust submit IN -o OUT [options]\n\n"
+        "Sends the points of IN to the shortcrust daemon (shortcrustd), which\n"
+        "reconstructs the mesh, and writes the mesh to OUT. Formats, summary\n"
+        "and report are those of `shortcrust reconstruct`, and so are the\n"
+        "triangles for the same input and options. IN may be .ply (ascii or\n"
+        "binary), .xyz/.txt/.pts/.csv, .off or .obj; OUT's extension picks the\n"
+        "format: .ply (binary unless --ascii), .off, .obj or .stl. The daemon\n"
+        "fills holes, prunes and finds boundaries with the defaults of\n"
+        "`reconstruct`, on one thread.\n\n"
+        "options:\n",
+        f);
+  sc_cli_job_usage_params(f);
+  fprintf(f, "      --socket PATH     the daemon's socket (default %s)\n",
+          sc_client_default_socket(sock, sizeof sock));
+  sc_cli_job_usage_output(f);
+  fputs("Progress (upload, each stage on the daemon, download) goes to stderr\n"
+        "when it is a terminal; the summary goes to stdout. Exit status: 0\n"
+        "done, 1 failed (the message says why), 2 bad command line.\n",
+        f);
 }
 
 enum { OPT_SOCKET = SC_CLI_OPT_OWN };
