@@ -171,34 +171,6 @@ struct XyzMap {
   }
 };
 
-// Puts the triangles in an order that depends only on the set: each with
-// its vertex numbers ascending, then sorted. The candidates carry no
-// orientation; the walk gives them one.
-void sort_triangles(std::vector<uint32_t> &tris) {
-  const size_t nt = tris.size() / 3;
-  for (size_t t = 0; t < nt; ++t) {
-    uint32_t *v = &tris[3 * t];
-    if (v[0] > v[1])
-      std::swap(v[0], v[1]);
-    if (v[1] > v[2])
-      std::swap(v[1], v[2]);
-    if (v[0] > v[1])
-      std::swap(v[0], v[1]);
-  }
-  std::vector<uint32_t> order(nt);
-  std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-    return std::lexicographical_compare(&tris[3 * size_t(a)],
-                                        &tris[3 * size_t(a)] + 3,
-                                        &tris[3 * size_t(b)],
-                                        &tris[3 * size_t(b)] + 3);
-  });
-  std::vector<uint32_t> out(tris.size());
-  for (size_t i = 0; i < nt; ++i)
-    std::memcpy(&out[3 * i], &tris[3 * size_t(order[i])], 3 * sizeof(uint32_t));
-  tris.swap(out);
-}
-
 // The thresholds of the candidate tests, computed once from the parameters.
 struct Criteria {
   int mode;
@@ -357,13 +329,14 @@ public:
     progress.stage(SC_STAGE_CANDIDATES);
     select_candidates(params, progress, out.tris, diag);
     diag.candidates = out.tris.size() / 3;
-    // Which cell reports a facet, and when, depends on heap addresses; the
-    // later stages break ties by the order of the candidates.
-    sort_triangles(out.tris);
     // The triangulation is not needed any more: free it before pruning so
     // that the peak memory is the triangulation's alone.
     if (!keep)
       dt_.clear();
+    // Which cell reports a facet, and when, depends on heap addresses; the
+    // later stages break ties by the order of the candidates. They carry no
+    // orientation: the walk gives them one.
+    canonical_order(out.tris, false);
     seconds[SC_STAGE_CANDIDATES] += sw.lap();
   }
 

@@ -138,6 +138,12 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 // fills the output fields of diag (triangles, boundary, components ...).
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
               Progress &progress, Surface &out, sc_diag_t &diag);
+// Puts the triangles in one order that depends only on the set: each
+// rotated to start at its smallest vertex number (keep_orientation) or with
+// its numbers ascending, then all sorted. Which Delaunay cell reports a
+// facet depends on heap addresses; with this, two runs on the same points
+// (a daemon job and a local run) list the same triangles in the same order.
+void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation);
 // Removes the closed components of fewer than min_triangles triangles
 // (bubbles between the layers of overlapping scans), and the open ones too
 // when open_too; s describes tris.

@@ -74,31 +74,6 @@ struct Closure {
   }
 };
 
-// Puts the triangles in one order that depends only on the set: each
-// rotated (keeping its orientation) to start at its smallest index, then
-// sorted. Which Delaunay cell reports a facet depends on heap addresses, so
-// without this two runs on the same points list the same triangles in
-// different orders; with it a daemon job and a local run write identical
-// files.
-void canonical_order(std::vector<uint32_t> &tris) {
-  struct Tri {
-    uint32_t v[3];
-  };
-  const size_t nt = tris.size() / 3;
-  std::vector<Tri> t(nt);
-  for (size_t i = 0; i < nt; ++i) {
-    const uint32_t *s = &tris[3 * i];
-    int k = s[0] < s[1] ? (s[0] < s[2] ? 0 : 2) : (s[1] < s[2] ? 1 : 2);
-    for (int j = 0; j < 3; ++j)
-      t[i].v[j] = s[(k + j) % 3];
-  }
-  std::sort(t.begin(), t.end(), [](const Tri &a, const Tri &b) {
-    return std::lexicographical_compare(a.v, a.v + 3, b.v, b.v + 3);
-  });
-  for (size_t i = 0; i < nt; ++i)
-    std::memcpy(&tris[3 * i], t[i].v, sizeof t[i].v);
-}
-
 } // namespace
 
 // Watertight mode, after extraction: closes the open components of surf.
@@ -147,7 +122,7 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   if (!Closure(db).ok) {
     std::vector<uint32_t> labelled = open;
     have_labels = dt_->close(labelled, progress, da);
-    canonical_order(labelled);
+    canonical_order(labelled, true);
     if (have_labels) {
       labelled.insert(labelled.end(), closed_part.begin(), closed_part.end());
       describe(lxyz, m, labelled, progress, a, da);
@@ -155,7 +130,8 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
         // Relabelling left a few pinches: cut them out and close the small
         // holes that leaves.
         drop_nonmanifold(lxyz, m, a.tris, progress);
-        fill_holes(lxyz, m, a.tris, kMaxFillLoop, {}, progress, da);
+        fill_holes(lxyz, m, a.tris, kMaxFillLoop, {}, progress, da,
+                 kMaxFillWork);
         describe(lxyz, m, a.tris, progress, a, da);
       }
       drop_debris(a, da);
@@ -358,7 +334,7 @@ sc_mesh_t *Recon::finish() {
       normals[3 * size_t(d.first) + j] = normals[3 * size_t(d.second) + j];
   for (uint32_t &v : surf.tris)
     v = f.to_input[v];
-  canonical_order(surf.tris);
+  canonical_order(surf.tris, true);
   seconds_[SC_STAGE_EXTRACT] += sw.lap();
 
   for (int s = 0; s < SC_STAGE_COUNT; ++s) {

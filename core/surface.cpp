@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <unordered_set>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -794,6 +795,31 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   if (max_hole >= 3)
     fill_holes(xyz, n, res, max_hole, boundary, progress, diag);
   describe(xyz, n, res, progress, out, diag);
+}
+
+void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
+  struct Tri {
+    uint32_t v[3];
+  };
+  const size_t nt = tris.size() / 3;
+  std::vector<Tri> t(nt);
+  for (size_t i = 0; i < nt; ++i) {
+    uint32_t *v = t[i].v;
+    const uint32_t *s = &tris[3 * i];
+    if (keep_orientation) {
+      int k = s[0] < s[1] ? (s[0] < s[2] ? 0 : 2) : (s[1] < s[2] ? 1 : 2);
+      for (int j = 0; j < 3; ++j)
+        v[j] = s[(k + j) % 3];
+    } else {
+      std::copy(s, s + 3, v);
+      std::sort(v, v + 3);
+    }
+  }
+  std::sort(t.begin(), t.end(), [](const Tri &a, const Tri &b) {
+    return std::lexicographical_compare(a.v, a.v + 3, b.v, b.v + 3);
+  });
+  for (size_t i = 0; i < nt; ++i)
+    std::memcpy(&tris[3 * i], t[i].v, sizeof t[i].v);
 }
 
 void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
