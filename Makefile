@@ -11,7 +11,8 @@ all: build
 setup:
 	@bash scripts/setup.sh
 
-$(BUILD)/CMakeCache.txt:
+# The packages come first even under `make -j`.
+$(BUILD)/CMakeCache.txt: | setup
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
 
 configure: $(BUILD)/CMakeCache.txt
