@@ -285,6 +285,9 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
     fprintf(f, ", %llu small hole%s filled",
             (unsigned long long)d->holes_filled,
             d->holes_filled == 1 ? "" : "s");
+  if (d->handles_cut)
+    fprintf(f, ", %llu handle%s cut", (unsigned long long)d->handles_cut,
+            d->handles_cut == 1 ? "" : "s");
   fprintf(f, ".\n");
   fprintf(f, "Path %s: %llu boundary sample%s, longest loop %llu edges.\n",
           sc_path_name(d->path), (unsigned long long)d->boundary_samples,
@@ -360,6 +363,7 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
   U64_(cells_relabelled);
   U64_(bubbles_dropped);
   U64_(samples_attached);
+  U64_(handles_cut);
 #undef U64_
   fputs("  \"path\": ", f);
   json_string(f, sc_path_name(d->path));

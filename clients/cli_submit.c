@@ -111,6 +111,7 @@ static void diag_from_values(const sc_client_mesh_t *m, sc_diag_t *d) {
   U_(cells_relabelled);
   U_(bubbles_dropped);
   U_(samples_attached);
+  U_(handles_cut);
 #undef U_
   d->path = (int)value_u64(m, "path");
   d->loops_by_length[0] = value_u64(m, "loops.3_10");

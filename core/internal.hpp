@@ -160,6 +160,20 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 // largest fan at each vertex: what is left is a 2-manifold (with boundary).
 void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                       Progress &progress);
+// A vertex whose triangles (those with in[t] set) form several fans is
+// pinched: keeps its largest fan. Removing triangles can pinch their other
+// vertices, so repeats until every vertex has one fan. Clears in[t] for the
+// triangles removed.
+void fix_fans(size_t n, const std::vector<uint32_t> &tris,
+              std::vector<uint8_t> &in);
+// Cuts the handles of an oriented, edge- and vertex-manifold surface that
+// closed round a hole: grows a region over each component, nearest triangle
+// first, refusing every triangle that would join two of its boundary loops
+// (raise its genus), then takes out the refused triangles of each cut that
+// runs mostly along holes and keeps the others. The result is a manifold
+// again; returns the number of cuts.
+size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
+                   Progress &progress);
 // Closes every hole of at most max_loop edges by a least-area patch (a loop
 // of more than a few hundred edges is first cut by short chords into
 // pieces), except the loops that boundary (which may be empty) marks as

@@ -111,6 +111,13 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
 
   Surface b;
   sc_diag_t db = diag;
+  // Handles that closed round a hole, where the scan has no samples, would
+  // stay in any closure: cut them first (see cut_handles()).
+  const uint64_t handles = cut_handles(lxyz, m, open, progress);
+  if (handles) {
+    surf.tris = open;
+    surf.tris.insert(surf.tris.end(), closed_part.begin(), closed_part.end());
+  }
   describe(lxyz, m, surf.tris, progress, b, db);
   fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork);
   describe(lxyz, m, b.tris, progress, b, db);
@@ -150,6 +157,7 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
     diag.path = SC_PATH_WATERTIGHT_FILL;
   }
   diag.cells_relabelled = relabelled;
+  diag.handles_cut = handles;
   // Pockets: closing may leave small closed components inside the main one
   // (the inside of a bubble, a cap that closed on itself). Those under a
   // hundredth of the surface go; their samples may be attached later.

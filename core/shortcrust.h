@@ -182,6 +182,8 @@ typedef struct sc_diag {
                                  watertight and auto modes) */
   uint64_t samples_attached;  /* samples left out by extraction and then
                                  inserted into the nearest triangle */
+  uint64_t handles_cut;       /* watertight: handles that closed round a
+                                 hole, cut before the holes were closed */
 } sc_diag_t;
 
 /* Values of sc_diag_t.path. */

@@ -227,9 +227,8 @@ int count_fans(uint32_t v, const std::vector<uint32_t> &star,
   return fans;
 }
 
-// A vertex whose triangles form several fans is pinched: keep its largest
-// fan. Removing triangles can pinch their other vertices, so repeat until
-// every vertex has one fan. Clears in[t] for the triangles removed.
+} // namespace
+
 void fix_fans(size_t n, const std::vector<uint32_t> &otri,
               std::vector<uint8_t> &in) {
   VertexStar ostar;
@@ -264,6 +263,8 @@ void fix_fans(size_t n, const std::vector<uint32_t> &otri,
     }
   }
 }
+
+namespace {
 
 double signed_volume6(const double *xyz, const uint32_t *t, const double *o) {
   const double *a = xyz + 3 * size_t(t[0]), *b = xyz + 3 * size_t(t[1]),

@@ -536,6 +536,7 @@ static void send_job_done(scd_conn_t *c, scd_job_t *j) {
       U("cells_relabelled", d->cells_relabelled),
       U("bubbles_dropped", d->bubbles_dropped),
       U("samples_attached", d->samples_attached),
+      U("handles_cut", d->handles_cut),
       F("seconds.upload", ms_between(j->begin_ns, j->end_ns) / 1e3),
       F("seconds.server", ms_between(j->begin_ns, uv_hrtime()) / 1e3),
   };

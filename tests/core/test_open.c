@@ -1,7 +1,7 @@
 /*
  * Open surfaces with known boundaries: a hemisphere, a wavy disc (a height
- * field over the unit disc), a cylinder open at both ends and a sphere with
- * a cap cut off.
+ * field over the unit disc), a cylinder open at both ends, a sphere with
+ * a cap cut off, and a torus with a hole (a true handle beside a hole).
  *
  *   test_core_open SURFACE MODE N [SEED]
  *
@@ -9,7 +9,8 @@
  * 2-manifold whose boundary loops are the true ones: as many, and every loop
  * vertex within three spacings of the true boundary curve; almost every
  * sample a vertex. In
- * watertight mode it must be one closed genus-0 manifold.
+ * watertight mode it must be one closed manifold of the surface's genus
+ * (0, and 1 for the torus).
  *
  * The samples are well spaced: area-uniform random candidates thinned by
  * dart throwing (a candidate is kept when no kept sample lies within 0.7
@@ -30,16 +31,31 @@
 
 #define PI 3.14159265358979323846
 
-enum { HEMISPHERE, WAVY_DISC, OPEN_CYLINDER, CUT_SPHERE, OPEN_COUNT };
-static const char *const open_names[OPEN_COUNT] = {"hemisphere", "wavy-disc",
-                                                   "open-cylinder",
-                                                   "cut-sphere"};
-/* Boundary loops of each surface, and its area (for the spacing). */
-static const int open_loops[OPEN_COUNT] = {1, 1, 2, 1};
+enum {
+  HEMISPHERE,
+  WAVY_DISC,
+  OPEN_CYLINDER,
+  CUT_SPHERE,
+  HOLED_TORUS,
+  OPEN_COUNT
+};
+static const char *const open_names[OPEN_COUNT] = {
+    "hemisphere", "wavy-disc", "open-cylinder", "cut-sphere", "holed-torus"};
+/* Boundary loops of each surface, the genus once closed, and its area (for
+ * the spacing). */
+static const int open_loops[OPEN_COUNT] = {1, 1, 2, 1, 1};
+static const int closed_genus[OPEN_COUNT] = {0, 0, 0, 0, 1};
 /* The cut sphere keeps z <= CUT_Z of the unit sphere. */
 #define CUT_Z 0.7
 #define CYL_R 0.5
 #define CYL_H 1.0
+/* The torus (radii TOR_R about the z axis, TOR_r of the tube) loses what
+ * lies within HOLE_R of HOLE_C, a point on top of the tube: a hole across
+ * most of the tube, which must not cost the torus its handle. */
+#define TOR_R 1.0
+#define TOR_r 0.4
+#define HOLE_R 0.6
+static double HOLE_C[3] = {0, 0, 0};
 
 static double wavy(double x, double y) { return 0.15 * sin(3 * x) * cos(2 * y); }
 
@@ -52,9 +68,17 @@ static double open_area(int s) {
                          depends on it */
   case OPEN_CYLINDER:
     return 2 * PI * CYL_R * 2 * CYL_H;
+  case HOLED_TORUS:
+    /* less the hole, about a disc of its radius */
+    return 4 * PI * PI * TOR_R * TOR_r - PI * HOLE_R * HOLE_R;
   default:
     return 2 * PI * (1 + CUT_Z);
   }
+}
+
+static double dist3(const double *a, const double *b) {
+  double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 }
 
 /* One area-uniform random point of surface s (the wavy disc is uniform in
@@ -62,6 +86,18 @@ static double open_area(int s) {
 static void open_point(int s, sc_rng_t *rng, double p[3]) {
   double u = sc_rng_uniform(rng), v = sc_rng_uniform(rng);
   switch (s) {
+  case HOLED_TORUS:
+    /* The tube angle by rejection against the area element, then outside
+     * the hole. */
+    for (;;) {
+      double t = 2 * PI * u, f = 2 * PI * v;
+      double w = TOR_R + TOR_r * cos(f);
+      p[0] = w * cos(t), p[1] = w * sin(t), p[2] = TOR_r * sin(f);
+      if (sc_rng_uniform(rng) * (TOR_R + TOR_r) <= w &&
+          dist3(p, HOLE_C) > HOLE_R)
+        return;
+      u = sc_rng_uniform(rng), v = sc_rng_uniform(rng);
+    }
   case HEMISPHERE:
   case CUT_SPHERE: {
     /* Archimedes: z uniform gives area-uniform points on the sphere. */
@@ -95,6 +131,10 @@ static double boundary_distance(int s, const double p[3]) {
     return fabs(rho - 1);
   case OPEN_CYLINDER:
     return CYL_H - fabs(p[2]);
+  case HOLED_TORUS:
+    /* The distance to the sphere that cut the hole: near the curve, close
+     * to the distance to it. */
+    return fabs(dist3(p, HOLE_C) - HOLE_R);
   default: {
     double r0 = sqrt(1 - CUT_Z * CUT_Z);
     return sqrt((rho - r0) * (rho - r0) + (p[2] - CUT_Z) * (p[2] - CUT_Z));
@@ -191,9 +231,16 @@ static size_t boundary_vertices(const uint32_t *tri, size_t nt, size_t n,
 
 int main(int argc, char **argv) {
   if (argc < 4) {
-    fprintf(stderr, "usage: %s SURFACE MODE N [SEED]\n", argv[0]);
+    fprintf(stderr, "usage: %s SURFACE MODE N [SEED [HOLE_ANGLE]]\n",
+            argv[0]);
     return 2;
   }
+  /* Where the torus's hole is: on top of the tube, at this angle about the
+   * z axis. */
+  const double hole_angle = argc > 5 ? strtod(argv[5], NULL) : 0;
+  HOLE_C[0] = TOR_R * cos(hole_angle);
+  HOLE_C[1] = TOR_R * sin(hole_angle);
+  HOLE_C[2] = TOR_r;
   int s = -1;
   for (int i = 0; i < OPEN_COUNT; ++i)
     if (strcmp(argv[1], open_names[i]) == 0)
@@ -234,12 +281,14 @@ int main(int argc, char **argv) {
   CHECK_EQ_INT(sc_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
                0);
   char line[512];
-  printf("%s %s n=%zu: %s path=%s boundary_samples=%llu holes=%llu/%llu (%.2f s)\n", argv[1],
-         argv[2], n, sc_meshcheck_summary(&c, line, sizeof line),
+  printf("%s %s n=%zu: %s path=%s boundary_samples=%llu holes=%llu/%llu "
+         "handles_cut=%llu (%.2f s)\n",
+         argv[1], argv[2], n, sc_meshcheck_summary(&c, line, sizeof line),
          sc_path_name(m->diag.path),
          (unsigned long long)m->diag.boundary_samples,
          (unsigned long long)m->diag.holes_filled,
-         (unsigned long long)m->diag.hole_triangles, t1 - t0);
+         (unsigned long long)m->diag.hole_triangles,
+         (unsigned long long)m->diag.handles_cut, t1 - t0);
   CHECK(c.manifold);
   CHECK(c.oriented);
   CHECK_EQ_INT(c.nonmanifold_edges, 0);
@@ -252,7 +301,7 @@ int main(int argc, char **argv) {
 
   if (mode == SC_MODE_WATERTIGHT) {
     CHECK(c.closed);
-    CHECK_EQ_INT(c.genus_total, 0);
+    CHECK_EQ_INT(c.genus_total, closed_genus[s]);
     CHECK(c.volume > 0);
     CHECK(m->diag.closed);
     CHECK(m->diag.path == SC_PATH_WATERTIGHT ||

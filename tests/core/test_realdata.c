@@ -1,13 +1,15 @@
 /*
  * Real scans shipped in tests/data: closed 2-manifolds of the known genus,
- * consistently oriented outward, with (almost) every sample a vertex.
+ * consistently oriented outward, with (almost) every sample a vertex, in
+ * the default mode or the one named.
  *
- *   test_core_realdata FILE GENUS
+ *   test_core_realdata FILE GENUS [cocone|watertight]
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <stdlib.h>
+#include <string.h>
 
 #include "check.h"
 #include "files.h"
@@ -15,9 +17,21 @@
 #include "testsupport.h"
 
 int main(int argc, char **argv) {
-  if (argc != 3) {
-    fprintf(stderr, "usage: %s FILE GENUS\n", argv[0]);
+  if (argc != 3 && argc != 4) {
+    fprintf(stderr, "usage: %s FILE GENUS [cocone|watertight]\n", argv[0]);
     return 2;
+  }
+  sc_params_t p;
+  sc_params_init(&p);
+  if (argc == 4) {
+    if (strcmp(argv[3], "cocone") == 0) {
+      p.mode = SC_MODE_COCONE;
+    } else if (strcmp(argv[3], "watertight") == 0) {
+      p.mode = SC_MODE_WATERTIGHT;
+    } else {
+      fprintf(stderr, "unknown mode '%s'\n", argv[3]);
+      return 2;
+    }
   }
   int genus = atoi(argv[2]);
   char msg[512];
@@ -26,8 +40,6 @@ int main(int argc, char **argv) {
     fprintf(stderr, "FAIL: %s\n", msg);
     return 1;
   }
-  sc_params_t p;
-  sc_params_init(&p);
   sc_mesh_t *m = NULL;
   int rc = sc_reconstruct(pts.xyz, pts.count, &p, &m, msg, sizeof msg);
   CHECK_EQ_INT(rc, 0);
@@ -40,7 +52,9 @@ int main(int argc, char **argv) {
                             m->triangle_count, NULL, &c),
                0);
   char line[512];
-  printf("%s: %s\n", argv[1], sc_meshcheck_summary(&c, line, sizeof line));
+  printf("%s %s: %s; handles cut %llu\n", argv[1], argc == 4 ? argv[3] : "",
+         sc_meshcheck_summary(&c, line, sizeof line),
+         (unsigned long long)m->diag.handles_cut);
   CHECK(c.manifold);
   CHECK(c.closed);
   CHECK(c.oriented);
