@@ -235,6 +235,17 @@ void sc_cli_progress_done(sc_cli_progress_t *p) {
 }
 
 static void genus_list(FILE *f, const sc_cli_result_t *r) {
+  const sc_diag_t *d = r->diag;
+  /* An open surface: the genus of the whole, from its Euler characteristic
+   * and its loops (2 c - 2 g - b = chi; the output is a manifold, so no two
+   * loops share a vertex). */
+  if (!d->closed) {
+    long long g = (2 * (long long)d->components - (long long)d->euler -
+                   (long long)d->boundary_loops) /
+                  2;
+    fprintf(f, "genus %lld", g);
+    return;
+  }
   /* "genus 1" for one closed component; "genera 0, 0, 1" for several. */
   size_t closed = 0;
   for (size_t i = 0; i < r->component_count; ++i)

@@ -31,11 +31,16 @@ int main(int argc, char **argv) {
     fprintf(stderr, "meshinfo: checker failed\n");
     return 1;
   }
+  /* genus: of the closed components; genus_all: of every component, open
+   * ones included (-1 when one is not a surface). */
+  long long all = 0;
+  for (size_t i = 0; i < c.components && all >= 0; ++i)
+    all = c.comp[i].genus < 0 ? -1 : all + c.comp[i].genus;
   printf("points=%zu triangles=%zu manifold=%d closed=%d oriented=%d "
-         "components=%llu genus=%lld unused=%llu outward=%d\n",
+         "components=%llu genus=%lld unused=%llu outward=%d genus_all=%lld\n",
          pts.count, ntri, c.manifold, c.closed, c.oriented,
          (unsigned long long)c.components, (long long)c.genus_total,
-         (unsigned long long)c.samples_unused, c.volume > 0);
+         (unsigned long long)c.samples_unused, c.volume > 0, all);
   sc_meshcheck_free(&c);
   free(tri);
   sc_points_free(&pts);

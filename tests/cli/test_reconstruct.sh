@@ -67,6 +67,15 @@ expect 2 "unknown extension '.xyz'" "$sc" reconstruct "$knot" -o "$tmp/x.xyz"
 expect 2 "unknown command 'frobnicate'" "$sc" frobnicate
 [ -e "$tmp/x.ply" ] && fail "a failed command wrote its output"
 
+# An open surface: the summary's genus is that of the whole surface, open
+# components included, as the independent checker counts it.
+expect 0 "Open 2-manifold" "$sc" reconstruct "$data/bunny_points.ply" \
+  -o "$tmp/b.ply" --mode boundary
+said=$(sed -n 's/.*), genus \([0-9-]*\);.*/\1/p' "$tmp/out")
+checked=$("$info" "$tmp/b.ply" | sed -n 's/.* genus_all=\([0-9-]*\).*/\1/p')
+[ -n "$said" ] && [ "$said" = "$checked" ] ||
+  fail "open bunny: summary says genus '$said', the checker '$checked'"
+
 # Bad input: status 1, a message naming the file, an old output kept.
 echo "keep" > "$tmp/old.ply"
 expect 1 "missing.ply" "$sc" reconstruct "$tmp/missing.ply" -o "$tmp/old.ply"
@@ -78,7 +87,7 @@ expect 1 "collinear" "$sc" reconstruct "$tmp/line.xyz" -o "$tmp/old.ply"
 printf 'ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0\n' > "$tmp/trunc.ply"
 expect 1 "trunc.ply" "$sc" reconstruct "$tmp/trunc.ply" -o "$tmp/old.ply"
 [ "$(cat "$tmp/old.ply")" = keep ] || fail "a failed run replaced the old output"
-ls "$tmp" | grep -q -v -E '^(old.ply|out|err|nan.xyz|line.xyz|trunc.ply|knot\..*|q.ply|r.json|s.ply|t.ply)$' &&
+ls "$tmp" | grep -q -v -E '^(old.ply|out|err|nan.xyz|line.xyz|trunc.ply|knot\..*|q.ply|r.json|s.ply|t.ply|b.ply)$' &&
   fail "temporary files left: $(ls "$tmp")"
 
 [ "$fails" -eq 0 ] && echo "all passed"
