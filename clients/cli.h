@@ -15,6 +15,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "files.h"
 #include "shortcrust.h"
 
 #define SC_PI 3.14159265358979323846
@@ -135,5 +136,21 @@ char *sc_cli_report_json(const sc_cli_result_t *r);
 
 /* Writes the JSON report to path atomically; prints an error on failure. */
 int sc_cli_write_report(const char *path, const sc_cli_result_t *r);
+
+/*
+ * The two ends of a mesh-producing job. sc_cli_job_read() checks that -o
+ * names a mesh format (SC_EXIT_USAGE otherwise), starts the progress line
+ * and reads the input (SC_EXIT_FAILURE, after the message, when it cannot);
+ * on SC_EXIT_OK the caller frees pts. sc_cli_job_write() writes the mesh to
+ * -o, fills r->seconds_write, clears the progress line, then writes the
+ * report and prints the summary; it returns the exit status.
+ */
+int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
+                    sc_mesh_format_t *fmt, sc_points_t *pts,
+                    double *seconds_read);
+int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
+                     sc_mesh_format_t fmt, const sc_points_t *pts,
+                     const uint32_t *tris, size_t ntri,
+                     const double *normals, sc_cli_result_t *r);
 
 #endif /* SC_CLI_H */

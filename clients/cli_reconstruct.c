@@ -120,28 +120,17 @@ int sc_cmd_reconstruct(int argc, char **argv) {
     return SC_EXIT_USAGE;
   const char *in_path = o.in_path, *out_path = o.out_path;
 
-  char msg[1024];
-  sc_mesh_format_t fmt;
-  if (sc_mesh_format_from_path(out_path, o.ascii, &fmt, msg, sizeof msg) < 0) {
-    sc_cli_error("%s", msg);
-    return SC_EXIT_USAGE;
-  }
-
   sc_cli_progress_t progress;
-  sc_cli_progress_init(&progress, o.quiet);
+  sc_mesh_format_t fmt;
+  sc_points_t pts;
+  double t_read;
+  int status = sc_cli_job_read(&o, &progress, &fmt, &pts, &t_read);
+  if (status != SC_EXIT_OK)
+    return status;
   params->progress = sc_cli_progress_fn;
   params->progress_user = &progress;
 
-  double t0 = sc_cli_now();
-  sc_cli_progress_step(&progress, "reading", 0);
-  sc_points_t pts;
-  if (sc_points_read(in_path, &pts, msg, sizeof msg) < 0) {
-    sc_cli_progress_done(&progress);
-    sc_cli_error("%s", msg);
-    return SC_EXIT_FAILURE;
-  }
-  double t_read = sc_cli_now() - t0;
-
+  char msg[1024];
   sc_mesh_t *mesh = NULL;
   int rc = sc_reconstruct(pts.xyz, pts.count, params, &mesh, msg, sizeof msg);
   if (rc < 0) {
@@ -156,34 +145,18 @@ int sc_cmd_reconstruct(int argc, char **argv) {
     return SC_EXIT_FAILURE;
   }
 
-  sc_cli_progress_step(&progress, "writing", 0);
-  t0 = sc_cli_now();
-  rc = sc_mesh_write(out_path, fmt, pts.xyz, pts.count, mesh->triangles,
-                     mesh->triangle_count, o.normals ? mesh->normals : NULL, msg,
-                     sizeof msg);
-  double t_write = sc_cli_now() - t0;
-  sc_cli_progress_done(&progress);
-  int status = SC_EXIT_OK;
-  if (rc < 0) {
-    sc_cli_error("%s", msg);
-    status = SC_EXIT_FAILURE;
-  } else {
-    sc_cli_result_t res = {
-        .command = "reconstruct",
-        .input = in_path,
-        .output = out_path,
-        .params = *params,
-        .diag = &mesh->diag,
-        .component_genus = mesh->component_genus,
-        .component_count = mesh->component_count,
-        .seconds_read = t_read,
-        .seconds_write = t_write,
-    };
-    if (o.report && sc_cli_write_report(o.report, &res) < 0)
-      status = SC_EXIT_FAILURE;
-    if (!o.quiet)
-      sc_cli_summary(stdout, &res);
-  }
+  sc_cli_result_t res = {
+      .command = "reconstruct",
+      .input = in_path,
+      .output = out_path,
+      .params = *params,
+      .diag = &mesh->diag,
+      .component_genus = mesh->component_genus,
+      .component_count = mesh->component_count,
+      .seconds_read = t_read,
+  };
+  status = sc_cli_job_write(&o, &progress, fmt, &pts, mesh->triangles,
+                            mesh->triangle_count, mesh->normals, &res);
   sc_mesh_free(mesh);
   sc_points_free(&pts);
   return status;

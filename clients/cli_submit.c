@@ -177,26 +177,15 @@ int sc_cmd_submit(int argc, char **argv) {
     return SC_EXIT_USAGE;
   }
 
-  char msg[1024];
-  sc_mesh_format_t fmt;
-  if (sc_mesh_format_from_path(out_path, o.ascii, &fmt, msg, sizeof msg) < 0) {
-    sc_cli_error("%s", msg);
-    return SC_EXIT_USAGE;
-  }
-
   sc_cli_progress_t progress;
-  sc_cli_progress_init(&progress, o.quiet);
-
-  double t0 = sc_cli_now();
-  sc_cli_progress_step(&progress, "reading", 0);
+  sc_mesh_format_t fmt;
   sc_points_t pts;
-  if (sc_points_read(in_path, &pts, msg, sizeof msg) < 0) {
-    sc_cli_progress_done(&progress);
-    sc_cli_error("%s", msg);
-    return SC_EXIT_FAILURE;
-  }
-  double t_read = sc_cli_now() - t0;
+  double t_read;
+  int status = sc_cli_job_read(&o, &progress, &fmt, &pts, &t_read);
+  if (status != SC_EXIT_OK)
+    return status;
 
+  char msg[1024];
   sc_client_options_t opts;
   sc_client_options_init(&opts);
   opts.socket_path = socket_path;
@@ -224,7 +213,7 @@ int sc_cmd_submit(int argc, char **argv) {
     rc = sc_client_wait(client, job, -1);
   if (rc < 0) {
     sc_cli_progress_done(&progress);
-    int status = SC_EXIT_FAILURE;
+    status = SC_EXIT_FAILURE;
     if (rc == SC_CLIENT_EINVAL) {
       sc_cli_error("submit: %s", sc_client_last_error(client));
       status = SC_EXIT_USAGE;
@@ -244,36 +233,19 @@ int sc_cmd_submit(int argc, char **argv) {
   sc_diag_t diag;
   diag_from_values(&mesh, &diag);
 
-  sc_cli_progress_step(&progress, "writing", 0);
-  t0 = sc_cli_now();
-  rc = sc_mesh_write(out_path, fmt, pts.xyz, pts.count, mesh.triangles,
-                     (size_t)mesh.triangle_count, o.normals ? mesh.normals : NULL,
-                     msg, sizeof msg);
-  double t_write = sc_cli_now() - t0;
-  sc_cli_progress_done(&progress);
-  int status = SC_EXIT_OK;
-  if (rc < 0) {
-    sc_cli_error("%s", msg);
-    status = SC_EXIT_FAILURE;
-  } else {
-    double transfer = mesh.seconds_upload + mesh.seconds_download;
-    sc_cli_result_t res = {
-        .command = "submit",
-        .input = in_path,
-        .output = out_path,
-        .params = params,
-        .diag = &diag,
-        .component_genus = mesh.genus,
-        .component_count = (size_t)mesh.component_count,
-        .seconds_read = t_read,
-        .seconds_write = t_write,
-        .seconds_transfer = transfer,
-    };
-    if (o.report && sc_cli_write_report(o.report, &res) < 0)
-      status = SC_EXIT_FAILURE;
-    if (!o.quiet)
-      sc_cli_summary(stdout, &res);
-  }
+  sc_cli_result_t res = {
+      .command = "submit",
+      .input = in_path,
+      .output = out_path,
+      .params = params,
+      .diag = &diag,
+      .component_genus = mesh.genus,
+      .component_count = (size_t)mesh.component_count,
+      .seconds_read = t_read,
+      .seconds_transfer = mesh.seconds_upload + mesh.seconds_download,
+  };
+  status = sc_cli_job_write(&o, &progress, fmt, &pts, mesh.triangles,
+                            (size_t)mesh.triangle_count, mesh.normals, &res);
   sc_client_job_free(job);
   sc_client_free(client);
   sc_points_free(&pts);
