@@ -313,19 +313,6 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
           d->seconds_total);
 }
 
-static void json_string(FILE *f, const char *s) {
-  fputc('"', f);
-  for (const unsigned char *p = (const unsigned char *)s; p && *p; ++p) {
-    if (*p == '"' || *p == '\\')
-      fprintf(f, "\\%c", *p);
-    else if (*p < 0x20)
-      fprintf(f, "\\u%04x", *p);
-    else
-      fputc(*p, f);
-  }
-  fputc('"', f);
-}
-
 char *sc_cli_report_json(const sc_cli_result_t *r) {
   char *buf = NULL;
   size_t len = 0;
@@ -334,13 +321,13 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
     return NULL;
   const sc_diag_t *d = r->diag;
   fputs("{\n  \"command\": ", f);
-  json_string(f, r->command);
+  sc_file_json_string(f, r->command);
   fputs(",\n  \"input\": ", f);
-  json_string(f, r->input);
+  sc_file_json_string(f, r->input);
   fputs(",\n  \"output\": ", f);
-  json_string(f, r->output);
+  sc_file_json_string(f, r->output);
   fputs(",\n  \"params\": {\"mode\": ", f);
-  json_string(f, sc_cli_mode_name(r->params.mode));
+  sc_file_json_string(f, sc_cli_mode_name(r->params.mode));
   fprintf(f,
           ", \"r\": %.17g, \"cocone_theta\": %.17g, \"paper_pruning\": %d, "
           "\"max_hole_edges\": %d, \"threads\": %d, \"boundary_rho\": %.17g, "
@@ -377,7 +364,7 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
   U64_(handles_cut);
 #undef U64_
   fputs("  \"path\": ", f);
-  json_string(f, sc_path_name(d->path));
+  sc_file_json_string(f, sc_path_name(d->path));
   fprintf(f, ",\n  \"loops_by_length\": [%llu, %llu, %llu, %llu],\n",
           (unsigned long long)d->loops_by_length[0],
           (unsigned long long)d->loops_by_length[1],

@@ -364,19 +364,6 @@ static void json_values(FILE *f, const sc_client_value_t *v, size_t n) {
   fputc('}', f);
 }
 
-static void json_string(FILE *f, const char *s) {
-  fputc('"', f);
-  for (const unsigned char *p = (const unsigned char *)s; *p; ++p) {
-    if (*p == '"' || *p == '\\')
-      fprintf(f, "\\%c", *p);
-    else if (*p < 0x20)
-      fprintf(f, "\\u%04x", *p);
-    else
-      fputc(*p, f);
-  }
-  fputc('"', f);
-}
-
 static void usage(FILE *f) {
   char sock[256];
   fprintf(
@@ -755,7 +742,7 @@ int main(int argc, char **argv) {
            (unsigned long long)all.failed);
     for (size_t k = 0; k < all.ncodes; k++) {
       printf("%s", k ? ", " : "");
-      json_string(stdout, all.codes[k].name);
+      sc_file_json_string(stdout, all.codes[k].name);
       printf(": %llu", (unsigned long long)all.codes[k].count);
     }
     printf("}, \"verify\": %s, \"verified\": %llu, \"verify_failures\": %llu, "
