@@ -6,18 +6,7 @@ set -u
 sc=$1 info=$2 data=$3
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fails=0
-fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
-
-# expect STATUS PATTERN CMD...: exit status and a message matching PATTERN.
-expect() {
-  want=$1 pat=$2
-  shift 2
-  "$@" >"$tmp/out" 2>"$tmp/err"
-  got=$?
-  [ "$got" -eq "$want" ] || fail "$* exited $got, expected $want: $(cat "$tmp/err")"
-  [ -z "$pat" ] || grep -q -- "$pat" "$tmp/out" "$tmp/err" || fail "$*: no '$pat' in: $(cat "$tmp/out" "$tmp/err")"
-}
+. "$(dirname "$0")/../support/expect.sh"
 
 knot=$data/knot1_points.ply
 expect 0 "usage: shortcrust reconstruct" "$sc" reconstruct --help

@@ -8,18 +8,7 @@
 set -u
 sc=$1 scd=$2 meshcmp=$3 data=$4
 . "$(dirname "$0")/daemon.sh"
-fails=0
-fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
-
-# expect STATUS PATTERN CMD...: exit status and a message matching PATTERN.
-expect() {
-  want=$1 pat=$2
-  shift 2
-  "$@" >"$tmp/out" 2>"$tmp/err"
-  got=$?
-  [ "$got" -eq "$want" ] || fail "$* exited $got, expected $want: $(cat "$tmp/err")"
-  [ -z "$pat" ] || grep -q -- "$pat" "$tmp/out" "$tmp/err" || fail "$*: no '$pat' in: $(cat "$tmp/out" "$tmp/err")"
-}
+. "$(dirname "$0")/../support/expect.sh"
 
 # Before any daemon: a clear message and status 1.
 expect 1 "daemon is not running" "$sc" ping --socket "$sock"
