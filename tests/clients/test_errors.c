@@ -241,7 +241,10 @@ static int kill_daemon(void *user, sc_client_job_t *job, uint32_t stage,
 
 static void connection_lost(void) {
   scdt_daemon_t d;
-  REQUIRE(scdt_daemon_start(&d, NULL) == 0, "daemon did not start");
+  /* One worker: the second job waits behind the first, so it cannot finish
+   * before the first one's progress kills the daemon. */
+  const char *args[] = {"--workers", "1", NULL};
+  REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
   sc_client_t *c = scct_open(d.sock, 0);
   const uint64_t n = 50000;
   double *xyz = scdt_sample(SC_SURF_TORUS, n, 4);
