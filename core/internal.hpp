@@ -123,16 +123,25 @@ struct Surface {
   std::vector<int32_t> component_genus;
   std::vector<uint8_t> in_closed; // per triangle: its component is closed
 };
+// The candidates' edges with their triangles in order about each edge
+// (surface.cpp): pruning builds it, extraction takes it over.
+struct EdgeTable;
+struct EdgeTableFree {
+  void operator()(EdgeTable *et) const;
+};
+typedef std::unique_ptr<EdgeTable, EdgeTableFree> EdgeTablePtr;
 // keep_vertex, when not empty, marks the vertices at which no edge is ever
-// sharp (boundary samples).
+// sharp (boundary samples). Leaves the candidates' edge table in `table`.
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
            bool erode_single, const std::vector<uint8_t> &keep_vertex,
-           std::vector<uint8_t> &alive, Progress &progress, sc_diag_t &diag);
+           std::vector<uint8_t> &alive, EdgeTablePtr &table,
+           Progress &progress, sc_diag_t &diag);
+// Takes the table prune() left for the same candidates and alive flags.
 // Holes mostly rimmed by samples marked in boundary are left open.
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
-             const std::vector<uint8_t> &alive, size_t max_hole,
-             const std::vector<uint8_t> &boundary, Progress &progress,
-             Surface &out, sc_diag_t &diag);
+             const std::vector<uint8_t> &alive, EdgeTablePtr table,
+             size_t max_hole, const std::vector<uint8_t> &boundary,
+             Progress &progress, Surface &out, sc_diag_t &diag);
 // The topology of a finished surface: components, boundary loops, genus,
 // manifold checks; closed components facing inward are flipped. Resets and
 // fills the output fields of diag (triangles, boundary, components ...).

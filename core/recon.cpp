@@ -267,15 +267,16 @@ sc_mesh_t *Recon::finish() {
     std::memcpy(&lxyz[3 * k], xyz_ + 3 * size_t(f.to_input[k]),
                 3 * sizeof(double));
   std::vector<uint8_t> alive;
+  EdgeTablePtr table;
   prune(lxyz.data(), m, f.tris, params_.paper_pruning != 0, f.boundary, alive,
-        progress, diag);
+        table, progress, diag);
   seconds_[SC_STAGE_PRUNE] += sw.lap();
 
   progress.stage(SC_STAGE_EXTRACT);
   Surface surf;
   // Watertight mode closes every hole by labelling cells, so nothing is
   // filled before that.
-  extract(lxyz.data(), m, f.tris, alive,
+  extract(lxyz.data(), m, f.tris, alive, std::move(table),
           watertight ? 0 : size_t(params_.max_hole_edges), f.boundary,
           progress, surf, diag);
   if (detects_boundary(params_.mode)) {

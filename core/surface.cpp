@@ -7,7 +7,6 @@
 #include "internal.hpp"
 
 #include <algorithm>
-#include <unordered_set>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -27,6 +26,8 @@ inline uint64_t edge_key(uint32_t a, uint32_t b) {
   return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
 }
 inline uint32_t key_lo(uint64_t k) { return uint32_t(k >> 32); }
+
+} // namespace
 
 // Every candidate edge with its triangles in the cyclic order in which they
 // appear when rotating about the edge, right-handed about the direction from
@@ -91,6 +92,34 @@ struct EdgeTable {
     first.push_back(uint32_t(entries.size()));
   }
 
+  // Keeps only the entries of triangles with alive[t] set, renumbered in
+  // order (the k-th live triangle becomes k): the table that build() would
+  // give for the live triangles alone, without sorting or angles again.
+  void keep_live(const std::vector<uint8_t> &alive) {
+    std::vector<uint32_t> renum(alive.size());
+    uint32_t nl = 0;
+    for (size_t t = 0; t < alive.size(); ++t)
+      renum[t] = alive[t] ? nl++ : UINT32_MAX;
+    tri_edge.assign(3 * size_t(nl), 0);
+    size_t out = 0, edges = 0;
+    for (size_t e = 0; e + 1 < first.size(); ++e) {
+      const size_t start = out;
+      for (uint32_t i = first[e]; i < first[e + 1]; ++i) {
+        const Entry &x = entries[i];
+        if (!alive[x.tri])
+          continue;
+        entries[out] = {x.key, x.angle, renum[x.tri], x.corner};
+        tri_edge[3 * size_t(entries[out].tri) + x.corner] = uint32_t(edges);
+        ++out;
+      }
+      if (out > start)
+        first[edges++] = uint32_t(start);
+    }
+    entries.resize(out);
+    first.resize(edges);
+    first.push_back(uint32_t(out));
+  }
+
   // Angle of the half-plane through edge lo-hi that contains point c.
   static double angle(const double *xyz, uint32_t lo, uint32_t hi,
                       uint32_t c) {
@@ -118,6 +147,10 @@ struct EdgeTable {
                       w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2]);
   }
 };
+
+void EdgeTableFree::operator()(EdgeTable *et) const { delete et; }
+
+namespace {
 
 // An edge is sharp when its live triangles fit in a wedge narrower than
 // pi/2 (a gap between consecutive ones exceeds 3 pi/2), or when it has
@@ -300,12 +333,16 @@ bool is_triangle_of(const EdgeTable &et, const std::vector<uint32_t> &tris,
 template <class HasEdge>
 bool patch(const double *xyz, const std::vector<uint32_t> &loop,
            HasEdge has_edge, std::vector<double> &cost,
-           std::vector<uint32_t> &split, std::vector<uint32_t> &res,
+           std::vector<double> &costT, std::vector<uint32_t> &split, std::vector<uint32_t> &res,
            std::vector<uint64_t> &chords) {
   const size_t L = loop.size();
+  // The loop's points side by side: the triple loop below reads them
+  // L^3 / 6 times.
+  std::vector<double> p(3 * L);
+  for (size_t i = 0; i < L; ++i)
+    std::memcpy(&p[3 * i], xyz + 3 * size_t(loop[i]), 3 * sizeof(double));
   auto area = [&](size_t i, size_t k, size_t j) {
-    const double *a = xyz + 3 * size_t(loop[i]), *b = xyz + 3 * size_t(loop[k]),
-                 *c = xyz + 3 * size_t(loop[j]);
+    const double *a = &p[3 * i], *b = &p[3 * k], *c = &p[3 * j];
     double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     double x = u[1] * w[2] - u[2] * w[1], y = u[2] * w[0] - u[0] * w[2],
@@ -313,26 +350,37 @@ bool patch(const double *xyz, const std::vector<uint32_t> &loop,
     return std::sqrt(x * x + y * y + z * z);
   };
   const double inf = std::numeric_limits<double>::infinity();
+  // cost[i L + j]: the least area over the sub-loop i..j; costT holds the
+  // same numbers transposed, so that the inner loop reads both of its
+  // operands along rows.
   cost.assign(L * L, inf);
+  costT.assign(L * L, inf);
   split.assign(L * L, UINT32_MAX);
   for (size_t i = 0; i + 1 < L; ++i)
-    cost[i * L + i + 1] = 0;
+    cost[i * L + i + 1] = costT[(i + 1) * L + i] = 0;
   for (size_t len = 2; len < L; ++len) {
     for (size_t i = 0; i + len < L; ++i) {
       size_t j = i + len;
       // (0, L-1) is a loop edge; any other chord must be a new edge.
       if (!(i == 0 && j == L - 1) && has_edge(loop[i], loop[j]))
         continue;
+      const double *left = &cost[i * L], *right = &costT[j * L];
+      double best = inf;
+      uint32_t best_k = UINT32_MAX;
       for (size_t k = i + 1; k < j; ++k) {
-        double c = cost[i * L + k] + cost[k * L + j];
-        if (c == inf)
+        // An area is never negative: a split that already costs as much as
+        // the best one so far (or cannot be done) is not worth the area.
+        double c = left[k] + right[k];
+        if (!(c < best))
           continue;
         c += area(i, k, j);
-        if (c < cost[i * L + j]) {
-          cost[i * L + j] = c;
-          split[i * L + j] = uint32_t(k);
+        if (c < best) {
+          best = c;
+          best_k = uint32_t(k);
         }
       }
+      cost[i * L + j] = costT[j * L + i] = best;
+      split[i * L + j] = best_k;
     }
   }
   if (cost[L - 1] == inf)
@@ -410,15 +458,54 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     return;
   EdgeTable et;
   et.build(xyz, n, res, progress, false);
-  // Chords added by earlier fills count as existing edges too: two holes
-  // that share vertices must not both add the same chord.
-  std::unordered_set<uint64_t> chords;
+  // Each vertex's neighbours along the surface's edges ...
+  std::vector<uint32_t> adj_first(n + 1, 0), adj(2 * et.edges());
+  for (size_t e = 0; e < et.edges(); ++e) {
+    const uint64_t k = et.entries[et.first[e]].key;
+    ++adj_first[key_lo(k) + 1];
+    ++adj_first[uint32_t(k) + 1];
+  }
+  for (size_t v = 0; v < n; ++v)
+    adj_first[v + 1] += adj_first[v];
+  {
+    std::vector<uint32_t> fill(adj_first.begin(), adj_first.end() - 1);
+    for (size_t e = 0; e < et.edges(); ++e) {
+      const uint64_t k = et.entries[et.first[e]].key;
+      adj[fill[key_lo(k)]++] = uint32_t(k);
+      adj[fill[uint32_t(k)]++] = key_lo(k);
+    }
+  }
+  // ... and along the chords added by earlier fills, which count as
+  // existing edges too: two holes that share vertices must not both add the
+  // same chord. A chord is two links, one in the list of each end, so that
+  // the chords of a hole that cannot be filled come off again in reverse.
+  struct Link {
+    uint32_t other, next;
+  };
+  std::vector<uint32_t> chord_head(n, UINT32_MAX);
+  std::vector<Link> links;
+  auto add_chord = [&](uint64_t k) {
+    const uint32_t a = key_lo(k), b = uint32_t(k);
+    links.push_back({b, chord_head[a]});
+    chord_head[a] = uint32_t(links.size() - 1);
+    links.push_back({a, chord_head[b]});
+    chord_head[b] = uint32_t(links.size() - 1);
+  };
+  auto drop_chords_to = [&](size_t mark) {
+    for (; links.size() > mark; links.resize(links.size() - 2)) {
+      const size_t i = links.size() - 2;
+      chord_head[links[i + 1].other] = links[i].next;
+      chord_head[links[i].other] = links[i + 1].next;
+    }
+  };
   auto has_edge = [&](uint32_t a, uint32_t b) {
-    uint64_t k = edge_key(a, b);
-    auto it = std::lower_bound(
-        et.entries.begin(), et.entries.end(), k,
-        [](const EdgeTable::Entry &x, uint64_t key) { return x.key < key; });
-    return (it != et.entries.end() && it->key == k) || chords.count(k) != 0;
+    for (uint32_t i = adj_first[a]; i < adj_first[a + 1]; ++i)
+      if (adj[i] == b)
+        return true;
+    for (uint32_t i = chord_head[a]; i != UINT32_MAX; i = links[i].next)
+      if (links[i].other == b)
+        return true;
+    return false;
   };
   // The hole runs against the orientation of the triangle on each boundary
   // edge: a triangle with x -> y leaves the hole edge y -> x.
@@ -440,7 +527,7 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
   }
   std::vector<uint32_t> loop;
   std::vector<std::vector<uint32_t>> loops, pieces;
-  std::vector<double> cost;
+  std::vector<double> cost, costT;
   std::vector<uint32_t> split;
   std::vector<uint8_t> seen(n, 0);
   for (uint32_t v0 = 0; v0 < n; ++v0) {
@@ -493,7 +580,7 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     // kMaxPatch edges; the pieces are patched one by one, and the hole is
     // filled only if all of them are.
     pieces.assign(1, hole);
-    std::vector<uint64_t> cuts;
+    const size_t mark = links.size();
     bool cut_ok = true;
     for (size_t p = 0; p < pieces.size() && cut_ok; ++p) {
       while (pieces[p].size() > kMaxPatch) {
@@ -503,8 +590,7 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
           break;
         }
         const std::vector<uint32_t> &q = pieces[p];
-        cuts.push_back(edge_key(q.front(), q.back()));
-        chords.insert(cuts.back());
+        add_chord(edge_key(q.front(), q.back()));
         pieces.push_back(std::move(rest));
       }
     }
@@ -515,15 +601,16 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     std::vector<uint64_t> added_chords;
     bool ok_all = cut_ok && work <= max_work;
     for (size_t p = 0; p < pieces.size() && ok_all; ++p)
-      ok_all = patch(xyz, pieces[p], has_edge, cost, split, res, added_chords);
+      ok_all = patch(xyz, pieces[p], has_edge, cost, costT, split, res,
+                     added_chords);
     if (ok_all) {
       max_work -= work;
-      chords.insert(added_chords.begin(), added_chords.end());
+      for (uint64_t k : added_chords)
+        add_chord(k);
     } else {
       // Not all pieces could be patched: leave the hole as it was.
       res.resize(before);
-      for (uint64_t k : cuts)
-        chords.erase(k);
+      drop_chords_to(mark);
       continue;
     }
     const size_t added = (res.size() - before) / 3;
@@ -534,8 +621,10 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
 
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
            bool erode_single, const std::vector<uint8_t> &keep_vertex,
-           std::vector<uint8_t> &alive, Progress &progress, sc_diag_t &diag) {
-  EdgeTable et;
+           std::vector<uint8_t> &alive, EdgeTablePtr &table,
+           Progress &progress, sc_diag_t &diag) {
+  table.reset(new EdgeTable);
+  EdgeTable &et = *table;
   et.build(xyz, n, cand, progress);
   const size_t ne = et.edges();
   alive.assign(cand.size() / 3, 1);
@@ -600,9 +689,9 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 }
 
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
-             const std::vector<uint8_t> &alive, size_t max_hole,
-             const std::vector<uint8_t> &boundary, Progress &progress,
-             Surface &out, sc_diag_t &diag) {
+             const std::vector<uint8_t> &alive, EdgeTablePtr table,
+             size_t max_hole, const std::vector<uint8_t> &boundary,
+             Progress &progress, Surface &out, sc_diag_t &diag) {
   const size_t nt = cand.size() / 3;
   // Only the survivors of pruning take part.
   std::vector<uint32_t> live;
@@ -610,8 +699,8 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     if (alive[t])
       live.insert(live.end(), &cand[3 * t], &cand[3 * t] + 3);
   const size_t nl = live.size() / 3;
-  EdgeTable et;
-  et.build(xyz, n, live, progress);
+  EdgeTable &et = *table;
+  et.keep_live(alive);
   VertexStar star;
   star.build(n, live, [](size_t) { return true; });
 
