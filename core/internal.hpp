@@ -120,7 +120,8 @@ std::unique_ptr<Triangulator> make_triangulator(int threads,
 // Returns the oriented output triangles and fills the output diagnostics.
 struct Surface {
   std::vector<uint32_t> tris;
-  std::vector<int32_t> component_genus;
+  std::vector<int32_t> component_genus; // per component, -1 when open
+  std::vector<int32_t> component;       // per triangle: its component
   std::vector<uint8_t> in_closed; // per triangle: its component is closed
 };
 // The candidates' edges with their triangles in order about each edge

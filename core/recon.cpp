@@ -118,7 +118,10 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
     surf.tris = open;
     surf.tris.insert(surf.tris.end(), closed_part.begin(), closed_part.end());
   }
-  describe(lxyz, m, surf.tris, progress, b, db);
+  // The surface was described after extraction, and cutting handles only
+  // takes triangles out of open components: no component to flip, and
+  // describe() runs once the holes are filled.
+  b.tris.swap(surf.tris);
   fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork);
   describe(lxyz, m, b.tris, progress, b, db);
   drop_debris(b, db);
@@ -163,8 +166,10 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   // hundredth of the surface go; their samples may be attached later.
   if (diag.components > 1) {
     const uint64_t comps = diag.components;
+    const size_t before_pockets = surf.tris.size();
     drop_small_closed(surf.tris, surf, surf.tris.size() / 3 / 100);
-    describe(lxyz, m, surf.tris, progress, surf, diag);
+    if (surf.tris.size() != before_pockets)
+      describe(lxyz, m, surf.tris, progress, surf, diag);
     diag.bubbles_dropped += comps - std::min(comps, diag.components);
   }
   // Every loop of the extracted surface was closed if the result is.

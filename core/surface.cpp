@@ -1032,6 +1032,7 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
   out.in_closed.assign(nr, 0);
   for (size_t t = 0; t < nr; ++t)
     out.in_closed[t] = B[comp_of[t]] == 0;
+  out.component.swap(comp_of);
   out.component_genus.assign(nc, -1);
   diag.euler = 0;
   diag.genus = 0;
@@ -1118,26 +1119,13 @@ double dist2(const double *x, const double *y) {
 void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
                        size_t min_triangles, bool open_too) {
   const size_t nt = tris.size() / 3;
-  // describe() keeps no per-triangle component, so count them again.
-  std::vector<std::pair<uint64_t, uint32_t>> edges;
-  edges.reserve(3 * nt);
+  std::vector<size_t> count(s.component_genus.size(), 0);
   for (size_t t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k)
-      edges.emplace_back(edge_key(tris[3 * t + k], tris[3 * t + (k + 1) % 3]),
-                         uint32_t(t));
-  std::sort(edges.begin(), edges.end());
-  UnionFind uf(nt);
-  for (size_t i = 1; i < edges.size(); ++i)
-    if (edges[i].first == edges[i - 1].first)
-      uf.unite(edges[i].second, edges[i - 1].second);
-  std::vector<size_t> count(nt, 0);
-  for (size_t t = 0; t < nt; ++t)
-    ++count[uf.find(uint32_t(t))];
+    ++count[s.component[t]];
   std::vector<uint32_t> res;
   res.reserve(tris.size());
   for (size_t t = 0; t < nt; ++t)
-    if ((!s.in_closed[t] && !open_too) ||
-        count[uf.find(uint32_t(t))] >= min_triangles)
+    if ((!s.in_closed[t] && !open_too) || count[s.component[t]] >= min_triangles)
       res.insert(res.end(), &tris[3 * t], &tris[3 * t] + 3);
   tris.swap(res);
 }
@@ -1147,15 +1135,18 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   size_t nt = tris.size() / 3;
   if (nt == 0)
     return 0;
+  std::vector<uint8_t> used(n, 0);
+  for (uint32_t v : tris)
+    used[v] = 1;
+  if (std::count(used.begin(), used.end(), 0) == 0)
+    return 0;
   // Stars that grow as triangles split.
   std::vector<std::vector<uint32_t>> star(n);
-  std::vector<uint8_t> used(n, 0);
   double edge_sum = 0;
   for (size_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) {
       uint32_t v = tris[3 * t + k];
       star[v].push_back(uint32_t(t));
-      used[v] = 1;
       edge_sum += std::sqrt(dist2(xyz + 3 * size_t(v),
                                   xyz + 3 * size_t(tris[3 * t + (k + 1) % 3])));
     }
@@ -1178,12 +1169,16 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 
   size_t attached = 0;
   std::vector<uint32_t> near;
+  // Each triangle near a sample is looked at once, though it is in the
+  // stars of three vertices.
+  std::vector<uint32_t> stamp;
   for (uint32_t s = 0; s < n; ++s) {
     progress.tick(s, n);
     if (used[s])
       continue;
     const double *p = xyz + 3 * size_t(s);
     near.clear();
+    stamp.resize(tris.size() / 3, UINT32_MAX);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
@@ -1191,8 +1186,11 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
           auto it = std::lower_bound(
               grid.begin(), grid.end(), std::make_pair(k, uint32_t(0)));
           for (; it != grid.end() && it->first == k; ++it)
-            near.insert(near.end(), star[it->second].begin(),
-                        star[it->second].end());
+            for (uint32_t t : star[it->second])
+              if (stamp[t] != s) {
+                stamp[t] = s;
+                near.push_back(t);
+              }
         }
     // The nearest triangle, if the sample is closer to it than its longest
     // edge (farther samples are outliers and stay out).
