@@ -595,7 +595,15 @@ private:
       }
     }
 
-    std::vector<Vh> queue;
+    // Growth from agreeing neighbours: a sample that passes the ratio test
+    // becomes interior when a cell around it whose circumcentre lies in the
+    // cocone of an interior neighbour joins it to that neighbour with poles
+    // that agree, until nothing changes. Only samples whose poles disagree
+    // can change: each of them looks once at the interior neighbours it
+    // has, and each that becomes interior passes it on to its own
+    // neighbours. (Growing outward from every interior sample would visit
+    // the star of every sample of the scan.)
+    std::vector<Vh> waiting;
     const float rho2 = float(rho * rho);
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v) {
@@ -603,40 +611,85 @@ private:
       d.flags &= uint8_t(~(kVRatio | kVInterior));
       if ((d.h2 > 0 && d.r2 <= rho2 * d.h2) || d.r2 <= kNearRatio2 * d.nn2)
         d.flags |= kVRatio;
-      if ((d.flags & kVRatio) && !(d.flags & kVDisagree)) {
+      if (!(d.flags & kVRatio))
+        continue;
+      if (!(d.flags & kVDisagree))
         d.flags |= kVInterior;
-        queue.push_back(v);
-      }
+      else
+        waiting.push_back(v);
     }
-    std::vector<Ch> inc;
+    // The links along which a waiting sample q can become interior: from a
+    // neighbour v that passes the ratio test, through a cell whose
+    // circumcentre is in v's cocone, when their poles agree. One pass over
+    // the cells that have a waiting sample, then a search from the
+    // interior samples along the links.
     const size_t m = dt_.number_of_vertices();
-    size_t grown = 0;
-    while (!queue.empty()) {
-      progress.tick(cells + (++grown) * cells / (m + 1), 2 * cells);
-      Vh v = queue.back();
-      queue.pop_back();
-      const VertexData &dv = v->info();
-      V3 pv = v3(v->point()), polev = {dv.pole[0], dv.pole[1], dv.pole[2]};
-      inc.clear();
-      dt_.finite_incident_cells(v, std::back_inserter(inc));
-      for (Ch c : inc) {
-        const float *ccc = c->info().cc;
-        V3 dir = V3{ccc[0], ccc[1], ccc[2]} - pv;
+    std::vector<uint8_t> state(m, 0); // 1 interior, 2 waiting
+    for (Vh q : waiting)
+      state[q->info().idx] = 2;
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v)
+      if (v->info().flags & kVInterior)
+        state[v->info().idx] = 1;
+    std::vector<std::pair<uint32_t, uint32_t>> links;
+    k = 0;
+    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
+         ++c, ++k) {
+      progress.tick(cells + k, 2 * cells);
+      Vh w[4];
+      bool any = false;
+      for (int j = 0; j < 4; ++j) {
+        w[j] = c->vertex(j);
+        any = any || state[w[j]->info().idx] == 2;
+      }
+      if (!any)
+        continue;
+      const float *ccc = c->info().cc;
+      const V3 cc = {ccc[0], ccc[1], ccc[2]};
+      for (int j = 0; j < 4; ++j) {
+        const VertexData &dv = w[j]->info();
+        if (state[dv.idx] == 0)
+          continue;
+        const V3 polev = {dv.pole[0], dv.pole[1], dv.pole[2]};
+        const V3 dir = cc - v3(w[j]->point());
         if (std::fabs(dot(dir, polev)) > sin_c * std::sqrt(norm2(dir)))
           continue;
-        for (int j = 0; j < 4; ++j) {
-          Vh q = c->vertex(j);
-          VertexData &dq = q->info();
-          if (q == v || (dq.flags & kVInterior) || !(dq.flags & kVRatio))
-            continue;
-          V3 poleq = {dq.pole[0], dq.pole[1], dq.pole[2]};
-          if (std::fabs(dot(polev, poleq)) >= cos_a) {
-            dq.flags |= kVInterior;
-            queue.push_back(q);
-          }
+        for (int i = 0; i < 4; ++i) {
+          const VertexData &dq = w[i]->info();
+          if (i != j && state[dq.idx] == 2 &&
+              std::fabs(dot(polev, V3{dq.pole[0], dq.pole[1], dq.pole[2]})) >=
+                  cos_a)
+            links.emplace_back(dv.idx, dq.idx);
         }
       }
     }
+    std::vector<uint32_t> first(m + 1, 0), to(links.size());
+    for (const auto &l : links)
+      ++first[l.first + 1];
+    for (size_t v = 0; v < m; ++v)
+      first[v + 1] += first[v];
+    {
+      std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+      for (const auto &l : links)
+        to[fill[l.first]++] = l.second;
+    }
+    links = {};
+    std::vector<uint32_t> grown;
+    for (uint32_t v = 0; v < m; ++v)
+      if (state[v] == 1 && first[v + 1] > first[v])
+        grown.push_back(v);
+    while (!grown.empty()) {
+      const uint32_t v = grown.back();
+      grown.pop_back();
+      for (uint32_t i = first[v]; i < first[v + 1]; ++i)
+        if (state[to[i]] == 2) {
+          state[to[i]] = 1;
+          grown.push_back(to[i]);
+        }
+    }
+    for (Vh q : waiting)
+      if (state[q->info().idx] == 1)
+        q->info().flags |= kVInterior;
 
     // Auto mode: when most samples are not interior the sample is too
     // sparse or too small to tell a boundary from undersampling (every
