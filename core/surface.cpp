@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <unordered_map>
 
 namespace sc {
 namespace {
@@ -38,6 +39,11 @@ struct EdgeTable {
     double angle;
     uint32_t tri;
     uint8_t corner; // the edge is (v[corner], v[corner + 1]) of tri
+    // Left uninitialised: build() writes every entry of a table sized up
+    // front, and zeroing it first was a pass over memory of its own.
+    Entry() {}
+    Entry(uint64_t k, double a, uint32_t t, uint8_t c)
+        : key(k), angle(a), tri(t), corner(c) {}
   };
   std::vector<Entry> entries;   // grouped by edge, each group by angle
   std::vector<uint32_t> first;  // edge id -> first entry; one extra at end
@@ -1166,6 +1172,15 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
     if (used[v])
       grid.emplace_back(key(xyz + 3 * size_t(v), 0, 0, 0), v);
   std::sort(grid.begin(), grid.end());
+  // Where each cell's run of the grid is: one hash lookup per cell looked
+  // at, not a binary search over the whole grid.
+  std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> runs;
+  runs.reserve(grid.size());
+  for (size_t i = 0, j; i < grid.size(); i = j) {
+    for (j = i + 1; j < grid.size() && grid[j].first == grid[i].first; ++j) {
+    }
+    runs.emplace(grid[i].first, std::make_pair(uint32_t(i), uint32_t(j)));
+  }
 
   size_t attached = 0;
   std::vector<uint32_t> near;
@@ -1182,11 +1197,11 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
-          uint64_t k = key(p, dx, dy, dz);
-          auto it = std::lower_bound(
-              grid.begin(), grid.end(), std::make_pair(k, uint32_t(0)));
-          for (; it != grid.end() && it->first == k; ++it)
-            for (uint32_t t : star[it->second])
+          auto run = runs.find(key(p, dx, dy, dz));
+          if (run == runs.end())
+            continue;
+          for (uint32_t i = run->second.first; i < run->second.second; ++i)
+            for (uint32_t t : star[grid[i].second])
               if (stamp[t] != s) {
                 stamp[t] = s;
                 near.push_back(t);
