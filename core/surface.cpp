@@ -232,7 +232,10 @@ int count_fans(uint32_t v, const std::vector<uint32_t> &star,
   fan_of.assign(m, -1);
   // Triangles around v are adjacent when they share an edge at v, that is
   // one of their two other vertices. Stars are small: quadratic is fine.
-  std::vector<uint32_t> other(2 * m);
+  // The scratch lives on between calls: this runs once per vertex.
+  thread_local std::vector<uint32_t> other;
+  thread_local std::vector<size_t> stack;
+  other.resize(2 * m);
   for (size_t i = 0; i < m; ++i) {
     const uint32_t *t = &tris[3 * size_t(star[i])];
     int j = 0;
@@ -241,7 +244,6 @@ int count_fans(uint32_t v, const std::vector<uint32_t> &star,
         other[2 * i + j++] = t[k];
   }
   int fans = 0;
-  std::vector<size_t> stack;
   for (size_t s = 0; s < m; ++s) {
     if (fan_of[s] >= 0)
       continue;
