@@ -131,6 +131,9 @@ struct EdgeTableFree {
   void operator()(EdgeTable *et) const;
 };
 typedef std::unique_ptr<EdgeTable, EdgeTableFree> EdgeTablePtr;
+// Frees the arrays that this thread's edge tables and vertex stars keep
+// for reuse (surface.cpp); called at the end of each reconstruction.
+void release_scratch();
 // keep_vertex, when not empty, marks the vertices at which no edge is ever
 // sharp (boundary samples). Leaves the candidates' edge table in `table`.
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,

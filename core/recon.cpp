@@ -228,6 +228,10 @@ void Recon::borrow(const double *xyz, size_t n) {
 }
 
 sc_mesh_t *Recon::finish() {
+  // However the reconstruction ends, the scratch it kept goes.
+  struct ScratchRelease {
+    ~ScratchRelease() { release_scratch(); }
+  } scratch_release;
   Progress progress(params_.progress, params_.progress_user);
   sc_diag_t diag;
   std::memset(&diag, 0, sizeof diag);

@@ -28,6 +28,34 @@ inline uint64_t edge_key(uint32_t a, uint32_t b) {
 }
 inline uint32_t key_lo(uint64_t k) { return uint32_t(k >> 32); }
 
+// The large arrays of the edge tables and vertex stars, which one
+// reconstruction builds a dozen times over, go back to a per-thread pool
+// when their table is done, and the next table takes the largest: pages the
+// kernel has already mapped, instead of fresh ones faulted in one at a time
+// (a fifth of the extraction time on the merged scans). release_scratch()
+// empties the pools at the end of each reconstruction.
+template <class T> struct Pool {
+  std::vector<std::vector<T>> spare;
+  std::vector<T> take() {
+    if (spare.empty())
+      return {};
+    auto best = std::max_element(spare.begin(), spare.end(),
+                                 [](const std::vector<T> &a,
+                                    const std::vector<T> &b) {
+                                   return a.capacity() < b.capacity();
+                                 });
+    std::vector<T> v = std::move(*best);
+    spare.erase(best);
+    v.clear();
+    return v;
+  }
+  void give(std::vector<T> &v) {
+    if (v.capacity() >= (size_t(1) << 16) && spare.size() < 8)
+      spare.push_back(std::move(v));
+  }
+};
+thread_local Pool<uint32_t> u32_pool;
+
 } // namespace
 
 // Every candidate edge with its triangles in the cyclic order in which they
@@ -48,6 +76,18 @@ struct EdgeTable {
   std::vector<Entry> entries;   // grouped by edge, each group by angle
   std::vector<uint32_t> first;  // edge id -> first entry; one extra at end
   std::vector<uint32_t> tri_edge; // 3 per triangle: edge (v[k], v[k+1])
+
+  static thread_local Pool<Entry> entry_pool;
+  EdgeTable()
+      : entries(entry_pool.take()), first(u32_pool.take()),
+        tri_edge(u32_pool.take()) {}
+  ~EdgeTable() {
+    entry_pool.give(entries);
+    u32_pool.give(first);
+    u32_pool.give(tri_edge);
+  }
+  EdgeTable(const EdgeTable &) = delete;
+  EdgeTable &operator=(const EdgeTable &) = delete;
 
   size_t edges() const { return first.size() - 1; }
 
@@ -154,7 +194,14 @@ struct EdgeTable {
   }
 };
 
+thread_local Pool<EdgeTable::Entry> EdgeTable::entry_pool;
+
 void EdgeTableFree::operator()(EdgeTable *et) const { delete et; }
+
+void release_scratch() {
+  EdgeTable::entry_pool.spare.clear();
+  u32_pool.spare.clear();
+}
 
 namespace {
 
@@ -204,6 +251,13 @@ struct UnionFind {
 // Vertex -> incident triangles, over the triangles that `keep` accepts.
 struct VertexStar {
   std::vector<uint32_t> first, tris;
+  VertexStar() : first(u32_pool.take()), tris(u32_pool.take()) {}
+  ~VertexStar() {
+    u32_pool.give(first);
+    u32_pool.give(tris);
+  }
+  VertexStar(const VertexStar &) = delete;
+  VertexStar &operator=(const VertexStar &) = delete;
   template <class Keep>
   void build(size_t n, const std::vector<uint32_t> &t, Keep keep) {
     first.assign(n + 1, 0);
