@@ -21,7 +21,7 @@ namespace {
 constexpr size_t kMinOpenLoop = 8;
 // Loops longer than this are cut into pieces before they are patched: the
 // least-area patch costs the cube of the length.
-constexpr size_t kMaxPatch = 64;
+constexpr size_t kMaxPatch = 32;
 
 inline uint64_t edge_key(uint32_t a, uint32_t b) {
   return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
