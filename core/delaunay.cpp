@@ -1056,15 +1056,17 @@ private:
     Criteria cr(params);
     const bool detect = detects_boundary(params.mode);
     size_t cells = dt_.number_of_cells(), k = 0;
-    V3 P[3], poles[3];
-    bool interior[3] = {true, true, true};
-    uint32_t idx[3];
+    V3 P[3], poles[3], CP[4], Cpoles[4];
+    bool interior[3] = {true, true, true}, Cinterior[4];
+    uint32_t idx[3], Cidx[4];
     const Vh inf = dt_.infinite_vertex();
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
          ++c, ++k) {
       progress.tick(k, cells);
       const float *ccc = c->info().cc;
       V3 cc = {ccc[0], ccc[1], ccc[2]};
+      // The cell's four vertices, read once for the facets it handles.
+      bool loaded = false;
       for (int f = 0; f < 4; ++f) {
         Ch nb = c->neighbor(f);
         // Each facet between two finite cells is handled from the cell at
@@ -1073,20 +1075,29 @@ private:
           continue;
         bool ray = nb->has_vertex(inf);
         ++diag.delaunay_facets;
+        if (!loaded) {
+          for (int j = 0; j < 4; ++j) {
+            Vh v = c->vertex(j);
+            const VertexData &d = v->info();
+            CP[j] = v3(v->point());
+            Cpoles[j] = {d.pole[0], d.pole[1], d.pole[2]};
+            Cidx[j] = d.idx;
+            Cinterior[j] = !detect || (d.flags & kVInterior) != 0;
+          }
+          loaded = true;
+        }
         for (int j = 0; j < 3; ++j) {
-          Vh v = c->vertex((f + 1 + j) % 4);
-          const VertexData &d = v->info();
-          P[j] = v3(v->point());
-          poles[j] = {d.pole[0], d.pole[1], d.pole[2]};
-          idx[j] = d.idx;
-          if (detect)
-            interior[j] = (d.flags & kVInterior) != 0;
+          const int i = (f + 1 + j) % 4;
+          P[j] = CP[i];
+          poles[j] = Cpoles[i];
+          idx[j] = Cidx[i];
+          interior[j] = Cinterior[i];
         }
         V3 other;
         if (ray) {
           // The dual of a hull facet is a ray leaving the hull outward.
           V3 nrm = cross(P[1] - P[0], P[2] - P[0]);
-          V3 o = v3(c->vertex(f)->point());
+          V3 o = CP[f];
           other = dot(nrm, o - P[0]) > 0 ? -1.0 * nrm : nrm;
         } else {
           const float *oc = nb->info().cc;
