@@ -81,6 +81,10 @@ struct CellData {
     float cc[3];  // circumcentre (guarded), set by the poles stage
     CellLabel w;  // watertight mode, after the candidates
   };
+  // Bit f: facet f is on the convex hull (its neighbour is infinite), set
+  // by the poles stage, so that the candidate pass need not read the
+  // neighbour to know.
+  uint8_t hull = 0;
   CellData() : cc{0, 0, 0} {}
 };
 typedef CGAL::Triangulation_vertex_base_with_info_3<VertexData, K> Vb;
@@ -439,6 +443,8 @@ private:
       if (!dt_.is_infinite(c))
         continue;
       int inf = c->index(dt_.infinite_vertex());
+      Ch fin = c->neighbor(inf);
+      fin->info().hull |= uint8_t(1u << fin->index(c));
       V3 pts[3];
       V3 nrm = hull_normal(c, inf, pts);
       for (int k = 0; k < 3; ++k) {
@@ -1059,10 +1065,22 @@ private:
     V3 P[3], poles[3], CP[4], Cpoles[4];
     bool interior[3] = {true, true, true}, Cinterior[4];
     uint32_t idx[3], Cidx[4];
-    const Vh inf = dt_.infinite_vertex();
+    // The neighbours and vertices of a cell are scattered over memory: ask
+    // for those of the cell a few places ahead while this one is tested.
+    constexpr int kAhead = 4;
+    auto ahead = dt_.finite_cells_begin();
+    for (int i = 0; i < kAhead && ahead != dt_.finite_cells_end(); ++i)
+      ++ahead;
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
          ++c, ++k) {
       progress.tick(k, cells);
+      if (ahead != dt_.finite_cells_end()) {
+        for (int f = 0; f < 4; ++f) {
+          __builtin_prefetch(&ahead->neighbor(f)->info());
+          __builtin_prefetch(&*ahead->vertex(f));
+        }
+        ++ahead;
+      }
       const float *ccc = c->info().cc;
       V3 cc = {ccc[0], ccc[1], ccc[2]};
       // The cell's four vertices, read once for the facets it handles.
@@ -1071,9 +1089,9 @@ private:
         Ch nb = c->neighbor(f);
         // Each facet between two finite cells is handled from the cell at
         // the lower address; that comparison needs no access to nb.
-        if (&*nb < &*c && !nb->has_vertex(inf))
+        const bool ray = (c->info().hull >> f) & 1;
+        if (&*nb < &*c && !ray)
           continue;
-        bool ray = nb->has_vertex(inf);
         ++diag.delaunay_facets;
         if (!loaded) {
           for (int j = 0; j < 4; ++j) {
