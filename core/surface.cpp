@@ -1202,16 +1202,30 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
     used[v] = 1;
   if (std::count(used.begin(), used.end(), 0) == 0)
     return 0;
-  // Stars that grow as triangles split.
-  std::vector<std::vector<uint32_t>> star(n);
+  // Stars that change as triangles split: each vertex's triangles at the
+  // start, then those it gained. A triangle split away from a vertex never
+  // comes back to it, so a star is read as the triangles that still have
+  // the vertex.
+  VertexStar star0;
+  star0.build(n, tris, [](size_t) { return true; });
+  std::vector<std::vector<uint32_t>> gained(n);
+  auto has = [&](uint32_t t, uint32_t v) {
+    const uint32_t *u = &tris[3 * size_t(t)];
+    return u[0] == v || u[1] == v || u[2] == v;
+  };
+  auto for_star = [&](uint32_t v, auto &&visit) {
+    for (uint32_t i = star0.first[v]; i < star0.first[v + 1]; ++i)
+      if (has(star0.tris[i], v))
+        visit(star0.tris[i]);
+    for (uint32_t t : gained[v])
+      if (has(t, v))
+        visit(t);
+  };
   double edge_sum = 0;
   for (size_t t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) {
-      uint32_t v = tris[3 * t + k];
-      star[v].push_back(uint32_t(t));
-      edge_sum += std::sqrt(dist2(xyz + 3 * size_t(v),
+    for (int k = 0; k < 3; ++k)
+      edge_sum += std::sqrt(dist2(xyz + 3 * size_t(tris[3 * t + k]),
                                   xyz + 3 * size_t(tris[3 * t + (k + 1) % 3])));
-    }
   const double cell = 2 * edge_sum / double(3 * nt);
   if (!(cell > 0))
     return 0;
@@ -1257,11 +1271,12 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
           if (run == runs.end())
             continue;
           for (uint32_t i = run->second.first; i < run->second.second; ++i)
-            for (uint32_t t : star[grid[i].second])
+            for_star(grid[i].second, [&](uint32_t t) {
               if (stamp[t] != s) {
                 stamp[t] = s;
                 near.push_back(t);
               }
+            });
         }
     // The nearest triangle, if the sample is closer to it than its longest
     // edge (farther samples are outliers and stay out).
@@ -1303,17 +1318,12 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
     auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
       uint32_t t = uint32_t(tris.size() / 3);
       tris.push_back(a), tris.push_back(b), tris.push_back(c);
-      star[a].push_back(t), star[b].push_back(t), star[c].push_back(t);
+      gained[a].push_back(t), gained[b].push_back(t), gained[c].push_back(t);
       return t;
-    };
-    auto unstar = [&](uint32_t w, uint32_t t) {
-      auto &st = star[w];
-      st.erase(std::remove(st.begin(), st.end(), t), st.end());
     };
     if (zero < 0) {
       set(bt, v[0], v[1], s);
-      star[s].push_back(bt);
-      unstar(v[2], bt);
+      gained[s].push_back(bt);
       add(v[1], v[2], s);
       add(v[2], v[0], s);
     } else {
@@ -1330,17 +1340,16 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
       uint32_t a = v[(k + 1) % 3], b = v[(k + 2) % 3], c = v[k];
       // The other triangle on edge a-b, running b -> a.
       uint32_t other = UINT32_MAX;
-      for (uint32_t t : star[a]) {
+      for_star(a, [&](uint32_t t) {
         if (t == bt)
-          continue;
+          return;
         const uint32_t *u = &tris[3 * size_t(t)];
         for (int j = 0; j < 3; ++j)
           if (u[j] == b && u[(j + 1) % 3] == a)
             other = t;
-      }
+      });
       set(bt, c, a, s);
-      star[s].push_back(bt);
-      unstar(b, bt);
+      gained[s].push_back(bt);
       add(c, s, b);
       if (other != UINT32_MAX) {
         uint32_t u[3];
@@ -1350,8 +1359,7 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
           ++j;
         uint32_t d = u[(j + 2) % 3];
         set(other, b, s, d);
-        star[s].push_back(other);
-        unstar(a, other);
+        gained[s].push_back(other);
         add(s, a, d);
       }
     }
