@@ -29,24 +29,9 @@ struct Region {
   std::vector<uint32_t> twin; // the other side's half-edge, or kNone
   std::vector<uint8_t> in;    // triangle is in the region
 
-  explicit Region(const std::vector<uint32_t> &t)
-      : twin(t.size(), kNone), in(t.size() / 3, 0) {
-    // Pair the half-edges of each edge (an oriented edge-manifold has one
-    // or two per edge).
-    std::vector<std::pair<uint64_t, uint32_t>> keys(t.size());
-    for (uint32_t h = 0; h < t.size(); ++h) {
-      uint32_t a = t[h], b = t[next_in_tri(h)];
-      keys[h] = {a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a, h};
-    }
-    std::sort(keys.begin(), keys.end());
-    for (size_t i = 0; i + 1 < keys.size(); ++i) {
-      if (keys[i].first != keys[i + 1].first ||
-          (i + 2 < keys.size() && keys[i + 2].first == keys[i].first) ||
-          (i > 0 && keys[i - 1].first == keys[i].first))
-        continue;
-      twin[keys[i].second] = keys[i + 1].second;
-      twin[keys[i + 1].second] = keys[i].second;
-    }
+  Region(size_t n, const std::vector<uint32_t> &t, Progress &progress)
+      : in(t.size() / 3, 0) {
+    pair_half_edges(n, t, progress, twin);
   }
 
   bool in_region(uint32_t h) const { return h != kNone && in[h / 3]; }
@@ -103,7 +88,7 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   const size_t nt = tris.size() / 3;
   if (nt == 0)
     return 0;
-  Region reg(tris);
+  Region reg(n, tris, progress);
   std::vector<double> centre(3 * nt);
   for (size_t t = 0; t < nt; ++t)
     for (int j = 0; j < 3; ++j)

@@ -179,6 +179,11 @@ void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 // triangles removed.
 void fix_fans(size_t n, const std::vector<uint32_t> &tris,
               std::vector<uint8_t> &in);
+// twin[h] for half-edge h = 3 t + k (from corner k of triangle t to corner
+// k + 1): the other half-edge of its edge when exactly two triangles share
+// the edge, else UINT32_MAX.
+void pair_half_edges(size_t n, const std::vector<uint32_t> &tris,
+                     Progress &progress, std::vector<uint32_t> &twin);
 // Cuts the handles of an oriented, edge- and vertex-manifold surface that
 // closed round a hole: grows a region over each component, nearest triangle
 // first, refusing every triangle that would join two of its boundary loops
