@@ -433,6 +433,31 @@ private:
     return l > 0 ? (1 / l) * n : V3{0, 0, 0};
   }
 
+  // Calls visit(c) on every finite cell c, asking a few cells ahead for the
+  // vertices and, with `neighbours`, the neighbouring cells that the visit
+  // reads: they are scattered over memory, and waiting for each in turn
+  // was most of the time of these passes.
+  template <class Visit> void for_cells(bool neighbours, Visit &&visit) {
+    constexpr int kAhead = 4;
+    const auto end = dt_.finite_cells_end();
+    auto ahead = dt_.finite_cells_begin();
+    for (int i = 0; i < kAhead && ahead != end; ++i)
+      ++ahead;
+    for (auto c = dt_.finite_cells_begin(); c != end; ++c) {
+      if (ahead != end) {
+        for (int j = 0; j < 4; ++j) {
+          const char *v = reinterpret_cast<const char *>(&*ahead->vertex(j));
+          __builtin_prefetch(v);
+          __builtin_prefetch(v + 64);
+          if (neighbours)
+            __builtin_prefetch(&ahead->neighbor(j)->info());
+        }
+        ++ahead;
+      }
+      visit(c);
+    }
+  }
+
   void compute_poles(size_t n, Progress &progress, std::vector<double> &poles,
                      sc_diag_t &diag) {
     const float kHull = std::numeric_limits<float>::infinity();
@@ -457,9 +482,8 @@ private:
     // Interior samples: the farthest Voronoi vertex of their cell. Each
     // cell keeps its circumcentre for the candidate pass.
     size_t cells = dt_.number_of_cells(), k = 0;
-    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
-         ++c, ++k) {
-      progress.tick(k, cells);
+    for_cells(false, [&](auto c) {
+      progress.tick(k++, cells);
       ++diag.delaunay_cells;
       V3 cc = centre(c, &diag);
       c->info().cc[0] = float(cc.x), c->info().cc[1] = float(cc.y),
@@ -476,7 +500,7 @@ private:
           d.pole[0] = dv.x, d.pole[1] = dv.y, d.pole[2] = dv.z;
         }
       }
-    }
+    });
     // Unit poles, also copied out by input index: the triangulation is gone
     // before the normals are made.
     poles.assign(3 * n, 0.0);
@@ -559,9 +583,8 @@ private:
     size_t cells = dt_.number_of_cells(), k = 0;
     V3 pole[4];
     bool in_cone[4];
-    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
-         ++c, ++k) {
-      progress.tick(k, 2 * cells);
+    for_cells(false, [&](auto c) {
+      progress.tick(k++, 2 * cells);
       const float *ccc = c->info().cc;
       V3 cc = {ccc[0], ccc[1], ccc[2]};
       // A circumcentre much farther than the cell is long comes from a
@@ -599,7 +622,7 @@ private:
           if (i != j && std::fabs(dot(pole[i], pole[j])) < cos_a)
             c->vertex(j)->info().flags |= kVDisagree;
       }
-    }
+    });
 
     // Growth from agreeing neighbours: a sample that passes the ratio test
     // becomes interior when a cell around it whose circumcentre lies in the
@@ -639,9 +662,8 @@ private:
         state[v->info().idx] = 1;
     std::vector<std::pair<uint32_t, uint32_t>> links;
     k = 0;
-    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
-         ++c, ++k) {
-      progress.tick(cells + k, 2 * cells);
+    for_cells(false, [&](auto c) {
+      progress.tick(cells + k++, 2 * cells);
       Vh w[4];
       bool any = false;
       for (int j = 0; j < 4; ++j) {
@@ -649,7 +671,7 @@ private:
         any = any || state[w[j]->info().idx] == 2;
       }
       if (!any)
-        continue;
+        return;
       const float *ccc = c->info().cc;
       const V3 cc = {ccc[0], ccc[1], ccc[2]};
       for (int j = 0; j < 4; ++j) {
@@ -668,7 +690,7 @@ private:
             links.emplace_back(dv.idx, dq.idx);
         }
       }
-    }
+    });
     std::vector<uint32_t> first(m + 1, 0), to(links.size());
     for (const auto &l : links)
       ++first[l.first + 1];
@@ -1065,22 +1087,8 @@ private:
     V3 P[3], poles[3], CP[4], Cpoles[4];
     bool interior[3] = {true, true, true}, Cinterior[4];
     uint32_t idx[3], Cidx[4];
-    // The neighbours and vertices of a cell are scattered over memory: ask
-    // for those of the cell a few places ahead while this one is tested.
-    constexpr int kAhead = 4;
-    auto ahead = dt_.finite_cells_begin();
-    for (int i = 0; i < kAhead && ahead != dt_.finite_cells_end(); ++i)
-      ++ahead;
-    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
-         ++c, ++k) {
-      progress.tick(k, cells);
-      if (ahead != dt_.finite_cells_end()) {
-        for (int f = 0; f < 4; ++f) {
-          __builtin_prefetch(&ahead->neighbor(f)->info());
-          __builtin_prefetch(&*ahead->vertex(f));
-        }
-        ++ahead;
-      }
+    for_cells(true, [&](auto c) {
+      progress.tick(k++, cells);
       const float *ccc = c->info().cc;
       V3 cc = {ccc[0], ccc[1], ccc[2]};
       // The cell's four vertices, read once for the facets it handles.
@@ -1127,7 +1135,7 @@ private:
           tris.push_back(idx[2]);
         }
       }
-    }
+    });
   }
 
   DT dt_;
