@@ -555,9 +555,9 @@ private:
     // the cell then opens up sideways, whatever the true normal is.
     const double cos_fan = std::cos((M_PI / 2 - params.cocone_theta) / 2);
     std::vector<std::pair<Vh, V3>> hull;
-    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
-      if (!dt_.is_infinite(c))
-        continue;
+    std::vector<Ch> outside;
+    dt_.incident_cells(dt_.infinite_vertex(), std::back_inserter(outside));
+    for (Ch c : outside) {
       int inf = c->index(dt_.infinite_vertex());
       V3 pts[3];
       V3 nrm = hull_normal(c, inf, pts);
