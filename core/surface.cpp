@@ -1316,6 +1316,18 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
       const uint32_t *v = &tris[3 * size_t(t)];
       const double *a = xyz + 3 * size_t(v[0]), *b = xyz + 3 * size_t(v[1]),
                    *c = xyz + 3 * size_t(v[2]);
+      // The distance to the triangle's bounding box is a lower bound: a
+      // triangle whose box is already farther than the best cannot win
+      // (with a margin far above rounding, so that nothing changes).
+      double box2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double lo = std::min(a[k], std::min(b[k], c[k])),
+                     hi = std::max(a[k], std::max(b[k], c[k]));
+        const double out = p[k] < lo ? lo - p[k] : p[k] > hi ? p[k] - hi : 0;
+        box2 += out * out;
+      }
+      if (box2 > best * (1 + 1e-9))
+        continue;
       double w[3];
       closest_on_triangle(p, a, b, c, w);
       double q[3];
