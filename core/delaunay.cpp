@@ -627,11 +627,10 @@ private:
     // Growth from agreeing neighbours: a sample that passes the ratio test
     // becomes interior when a cell around it whose circumcentre lies in the
     // cocone of an interior neighbour joins it to that neighbour with poles
-    // that agree, until nothing changes. Only samples whose poles disagree
-    // can change: each of them looks once at the interior neighbours it
-    // has, and each that becomes interior passes it on to its own
-    // neighbours. (Growing outward from every interior sample would visit
-    // the star of every sample of the scan.)
+    // that agree, until nothing changes. Only the samples that pass the
+    // ratio test but whose poles disagree (waiting) can change, so only the
+    // cells around them are looked at below, instead of the star of every
+    // interior sample.
     std::vector<Vh> waiting;
     const float rho2 = float(rho * rho);
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();

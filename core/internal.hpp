@@ -195,8 +195,9 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 // Closes every hole of at most max_loop edges by a least-area patch (a loop
 // of more than a few dozen edges is first cut by short chords into
 // pieces), except the loops that boundary (which may be empty) marks as
-// where the surface ends. The patches together take at most max_work steps of the dynamic
-// programme (about L^3 / 6 for a loop of L edges); loops beyond it stay.
+// where the surface ends. The patches together take at most max_work steps
+// of the dynamic programme (about L^3 / 6 for a loop of L edges); loops
+// beyond it stay.
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                 size_t max_loop, const std::vector<uint8_t> &boundary,
                 Progress &progress, sc_diag_t &diag,

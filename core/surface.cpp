@@ -411,8 +411,8 @@ bool is_triangle_of(const EdgeTable &et, const std::vector<uint32_t> &tris,
 template <class HasEdge>
 bool patch(const double *xyz, const std::vector<uint32_t> &loop,
            HasEdge has_edge, std::vector<double> &cost,
-           std::vector<double> &costT, std::vector<uint32_t> &split, std::vector<uint32_t> &res,
-           std::vector<uint64_t> &chords) {
+           std::vector<double> &costT, std::vector<uint32_t> &split,
+           std::vector<uint32_t> &res, std::vector<uint64_t> &chords) {
   const size_t L = loop.size();
   // The loop's points side by side: the triple loop below reads them
   // L^3 / 6 times.
@@ -1217,7 +1217,8 @@ void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
   std::vector<uint32_t> res;
   res.reserve(tris.size());
   for (size_t t = 0; t < nt; ++t)
-    if ((!s.in_closed[t] && !open_too) || count[s.component[t]] >= min_triangles)
+    if ((!s.in_closed[t] && !open_too) ||
+        count[s.component[t]] >= min_triangles)
       res.insert(res.end(), &tris[3 * t], &tris[3 * t] + 3);
   tris.swap(res);
 }
