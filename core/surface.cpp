@@ -1211,6 +1211,8 @@ double dist2(const double *x, const double *y) {
 void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
                        size_t min_triangles, bool open_too) {
   const size_t nt = tris.size() / 3;
+  if (s.component.size() != nt || s.in_closed.size() != nt)
+    throw Error(SC_EINTERNAL, "components out of step with the surface");
   std::vector<size_t> count(s.component_genus.size(), 0);
   for (size_t t = 0; t < nt; ++t)
     ++count[s.component[t]];
