@@ -632,6 +632,8 @@ private:
     // cells around them are looked at below, instead of the star of every
     // interior sample.
     std::vector<Vh> waiting;
+    const size_t m = dt_.number_of_vertices();
+    std::vector<uint8_t> state(m, 0); // by vertex number: 1 interior, 2 waiting
     const float rho2 = float(rho * rho);
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v) {
@@ -641,24 +643,19 @@ private:
         d.flags |= kVRatio;
       if (!(d.flags & kVRatio))
         continue;
-      if (!(d.flags & kVDisagree))
+      if (!(d.flags & kVDisagree)) {
         d.flags |= kVInterior;
-      else
+        state[d.idx] = 1;
+      } else {
         waiting.push_back(v);
+        state[d.idx] = 2;
+      }
     }
     // The links along which a waiting sample q can become interior: from a
     // neighbour v that passes the ratio test, through a cell whose
     // circumcentre is in v's cocone, when their poles agree. One pass over
     // the cells that have a waiting sample, then a search from the
     // interior samples along the links.
-    const size_t m = dt_.number_of_vertices();
-    std::vector<uint8_t> state(m, 0); // 1 interior, 2 waiting
-    for (Vh q : waiting)
-      state[q->info().idx] = 2;
-    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
-         ++v)
-      if (v->info().flags & kVInterior)
-        state[v->info().idx] = 1;
     std::vector<std::pair<uint32_t, uint32_t>> links;
     k = 0;
     for_cells(false, [&](auto c) {
