@@ -123,6 +123,16 @@ struct Surface {
   std::vector<int32_t> component_genus; // per component, -1 when open
   std::vector<int32_t> component;       // per triangle: its component
   std::vector<uint8_t> in_closed; // per triangle: its component is closed
+  // What describe() counted in each component, so that dropping whole
+  // components or splitting triangles need not count again. The vertex
+  // counts are per component only when no vertex is pinched.
+  struct Part {
+    int64_t faces = 0, edges = 0, vertices = 0;
+    uint64_t boundary_edges = 0, loops = 0, nonmanifold_edges = 0;
+    uint64_t longest_loop = 0, loops_by_length[4] = {0, 0, 0, 0};
+  };
+  std::vector<Part> parts;
+  uint64_t pinched = 0;
 };
 // The candidates' edges with their triangles in order about each edge
 // (surface.cpp): pruning builds it, extraction takes it over.
@@ -151,6 +161,8 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 // fills the output fields of diag (triangles, boundary, components ...).
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
               Progress &progress, Surface &out, sc_diag_t &diag);
+// Fills those fields of diag, and s.component_genus, from s.parts.
+void summarise(Surface &s, sc_diag_t &diag);
 // Puts the triangles in one order that depends only on the set: each
 // rotated to start at its smallest vertex number (keep_orientation) or with
 // its numbers ascending, then all sorted. Which Delaunay cell reports a
@@ -159,16 +171,19 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation);
 // Removes the closed components of fewer than min_triangles triangles
 // (bubbles between the layers of overlapping scans), and the open ones too
-// when open_too; s describes tris.
-void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
-                       size_t min_triangles,
-                       bool open_too = false);
+// when open_too, from a surface that describe() filled; s and diag then
+// describe what is left. Returns the triangles removed.
+size_t drop_small_closed(const double *xyz, size_t n, Surface &s,
+                         size_t min_triangles, bool open_too,
+                         Progress &progress, sc_diag_t &diag);
 // Inserts every sample that is in no triangle into the nearest triangle
 // (splitting it in three, or the two triangles of the nearest edge in
 // two each) when it is closer to it than the triangle's longest edge.
-// Keeps the surface a consistently oriented manifold. Returns the count.
-size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
-                      Progress &progress);
+// Keeps the surface a consistently oriented manifold, with its components,
+// genus and loops; s and diag, which describe() filled, describe the
+// result. Returns the count.
+size_t attach_samples(const double *xyz, size_t n, Surface &s,
+                      Progress &progress, sc_diag_t &diag);
 // Removes every triangle on an edge with more than two, then keeps the
 // largest fan at each vertex: what is left is a 2-manifold (with boundary).
 void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,

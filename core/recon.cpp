@@ -102,10 +102,9 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   // small open components go (their samples may be attached later).
   auto drop_debris = [&](Surface &s, sc_diag_t &d) {
     if (!d.closed && d.components > 1 && !s.tris.empty()) {
-      drop_small_closed(s.tris, s,
+      drop_small_closed(lxyz, m, s,
                         std::max<size_t>(kMinBubble, s.tris.size() / 3 / 1000),
-                        true);
-      describe(lxyz, m, s.tris, progress, s, d);
+                        true, progress, d);
     }
   };
 
@@ -166,10 +165,8 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   // hundredth of the surface go; their samples may be attached later.
   if (diag.components > 1) {
     const uint64_t comps = diag.components;
-    const size_t before_pockets = surf.tris.size();
-    drop_small_closed(surf.tris, surf, surf.tris.size() / 3 / 100);
-    if (surf.tris.size() != before_pockets)
-      describe(lxyz, m, surf.tris, progress, surf, diag);
+    drop_small_closed(lxyz, m, surf, surf.tris.size() / 3 / 100, false,
+                      progress, diag);
     diag.bubbles_dropped += comps - std::min(comps, diag.components);
   }
   // Every loop of the extracted surface was closed if the result is.
@@ -294,21 +291,16 @@ sc_mesh_t *Recon::finish() {
     // watertight mode closes the surface while every triangle is still a
     // Delaunay facet (the labelling needs that); then every sample near the
     // surface is inserted into it.
-    const size_t before = surf.tris.size() / 3;
     const uint64_t closed_before = diag.closed_components;
-    drop_small_closed(surf.tris, surf,
-                      std::max<size_t>(kMinBubble, before / 1000));
-    // describe() is a pass over the whole surface: skip it where nothing
-    // changed since the last one.
-    if (surf.tris.size() / 3 != before)
-      describe(lxyz.data(), m, surf.tris, progress, surf, diag);
+    drop_small_closed(lxyz.data(), m, surf,
+                      std::max<size_t>(kMinBubble, surf.tris.size() / 3 / 1000),
+                      false, progress, diag);
     diag.bubbles_dropped =
         closed_before - std::min(closed_before, diag.closed_components);
     if (watertight)
       close_surface(lxyz.data(), m, progress, surf, diag);
-    diag.samples_attached = attach_samples(lxyz.data(), m, surf.tris, progress);
-    if (diag.samples_attached)
-      describe(lxyz.data(), m, surf.tris, progress, surf, diag);
+    diag.samples_attached =
+        attach_samples(lxyz.data(), m, surf, progress, diag);
   }
 
   // Per-vertex normals: the pole direction, signed to agree with the

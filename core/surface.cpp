@@ -1010,12 +1010,6 @@ void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
               Progress &progress, Surface &out, sc_diag_t &diag) {
-  diag.triangles = diag.boundary_edges = diag.boundary_loops = 0;
-  diag.nonmanifold_edges = diag.nonmanifold_vertices = 0;
-  diag.components = diag.closed_components = 0;
-  diag.longest_loop = 0;
-  for (uint64_t &l : diag.loops_by_length)
-    l = 0;
   const size_t nr = res.size() / 3;
   EdgeTable rt;
   rt.build(xyz, n, res, progress, false);
@@ -1057,55 +1051,48 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
       root_comp[r] = nc++;
     comp_of[t] = root_comp[r];
   }
-  std::vector<int64_t> F(nc, 0), E(nc, 0), V(nc, 0), B(nc, 0), L(nc, 0);
-  std::vector<double> vol(nc, 0.0);
+  std::vector<Surface::Part> parts(nc);
   for (size_t t = 0; t < nr; ++t)
-    ++F[comp_of[t]];
+    ++parts[comp_of[t]].faces;
   UnionFind bloops(n);
-  std::vector<uint8_t> on_boundary(n, 0);
   for (size_t e = 0; e < rt.edges(); ++e) {
     uint32_t cnt = rt.first[e + 1] - rt.first[e];
-    int32_t c = comp_of[rt.entries[rt.first[e]].tri];
-    ++E[c];
+    Surface::Part &p = parts[comp_of[rt.entries[rt.first[e]].tri]];
+    ++p.edges;
     if (cnt == 1) {
-      ++B[c];
-      ++diag.boundary_edges;
+      ++p.boundary_edges;
       uint64_t k = rt.entries[rt.first[e]].key;
       bloops.unite(key_lo(k), uint32_t(k));
-      on_boundary[key_lo(k)] = on_boundary[uint32_t(k)] = 1;
     } else if (cnt > 2) {
-      ++diag.nonmanifold_edges;
-    }
-  }
-  // Loop lengths: boundary edges per loop (loops that touch at a vertex
-  // count as one).
-  {
-    std::vector<uint64_t> loop_edges(n, 0);
-    for (size_t e = 0; e < rt.edges(); ++e)
-      if (rt.first[e + 1] - rt.first[e] == 1)
-        ++loop_edges[bloops.find(key_lo(rt.entries[rt.first[e]].key))];
-    for (uint32_t v = 0; v < n; ++v) {
-      uint64_t len = loop_edges[v];
-      if (len == 0)
-        continue;
-      diag.longest_loop = std::max(diag.longest_loop, len);
-      ++diag.loops_by_length[len <= 10 ? 0 : len <= 100 ? 1 : len <= 1000 ? 2 : 3];
+      ++p.nonmanifold_edges;
     }
   }
   std::vector<int32_t> vcomp(n, -1);
   for (size_t t = 0; t < nr; ++t)
     for (int k = 0; k < 3; ++k)
       vcomp[res[3 * t + k]] = comp_of[t];
-  size_t used_vertices = 0;
-  for (uint32_t v = 0; v < n; ++v) {
-    if (vcomp[v] < 0)
-      continue;
-    ++used_vertices;
-    ++V[vcomp[v]];
-    if (on_boundary[v] && bloops.find(v) == v)
-      ++L[vcomp[v]];
+  // Loops, and their lengths in boundary edges (loops that touch at a
+  // vertex count as one).
+  {
+    std::vector<uint64_t> loop_edges(n, 0);
+    for (size_t e = 0; e < rt.edges(); ++e)
+      if (rt.first[e + 1] - rt.first[e] == 1)
+        ++loop_edges[bloops.find(key_lo(rt.entries[rt.first[e]].key))];
+    for (uint32_t v = 0; v < n; ++v) {
+      if (vcomp[v] < 0)
+        continue;
+      Surface::Part &p = parts[vcomp[v]];
+      ++p.vertices;
+      const uint64_t len = loop_edges[v];
+      if (len == 0)
+        continue;
+      ++p.loops;
+      p.longest_loop = std::max(p.longest_loop, len);
+      ++p.loops_by_length[len <= 10 ? 0 : len <= 100 ? 1 : len <= 1000 ? 2 : 3];
+    }
   }
   // Signed volumes about each component's first vertex, for precision.
+  std::vector<double> vol(nc, 0.0);
   std::vector<uint32_t> origin(nc, UINT32_MAX);
   for (size_t t = 0; t < nr; ++t) {
     int32_t c = comp_of[t];
@@ -1115,35 +1102,54 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
   }
   for (size_t t = 0; t < nr; ++t) {
     int32_t c = comp_of[t];
-    if (B[c] == 0 && vol[c] < 0)
+    if (parts[c].boundary_edges == 0 && vol[c] < 0)
       std::swap(res[3 * t + 1], res[3 * t + 2]);
   }
 
-  diag.nonmanifold_vertices = pinched;
-
   out.in_closed.assign(nr, 0);
   for (size_t t = 0; t < nr; ++t)
-    out.in_closed[t] = B[comp_of[t]] == 0;
+    out.in_closed[t] = parts[comp_of[t]].boundary_edges == 0;
   out.component.swap(comp_of);
-  out.component_genus.assign(nc, -1);
+  out.parts.swap(parts);
+  out.pinched = pinched;
+  out.tris.swap(res);
+  summarise(out, diag);
+}
+
+void summarise(Surface &s, sc_diag_t &diag) {
+  diag.triangles = diag.boundary_edges = diag.boundary_loops = 0;
+  diag.nonmanifold_edges = 0;
+  diag.components = diag.closed_components = 0;
+  diag.longest_loop = 0;
+  for (uint64_t &l : diag.loops_by_length)
+    l = 0;
   diag.euler = 0;
   diag.genus = 0;
-  for (int32_t c = 0; c < nc; ++c) {
-    int64_t chi = V[c] - E[c] + F[c];
+  s.component_genus.assign(s.parts.size(), -1);
+  uint64_t used_vertices = 0;
+  for (size_t c = 0; c < s.parts.size(); ++c) {
+    const Surface::Part &p = s.parts[c];
+    const int64_t chi = p.vertices - p.edges + p.faces;
     diag.euler += chi;
-    if (B[c] == 0) {
+    if (p.boundary_edges == 0) {
       ++diag.closed_components;
-      out.component_genus[c] = int32_t((2 - chi) / 2);
+      s.component_genus[c] = int32_t((2 - chi) / 2);
       diag.genus += (2 - chi) / 2;
     }
-    diag.boundary_loops += L[c];
+    diag.boundary_edges += p.boundary_edges;
+    diag.boundary_loops += p.loops;
+    diag.nonmanifold_edges += p.nonmanifold_edges;
+    diag.longest_loop = std::max(diag.longest_loop, p.longest_loop);
+    for (int k = 0; k < 4; ++k)
+      diag.loops_by_length[k] += p.loops_by_length[k];
+    used_vertices += uint64_t(p.vertices);
   }
-  diag.components = nc;
-  diag.triangles = nr;
-  diag.closed = nr > 0 && diag.boundary_edges == 0;
-  uint64_t distinct = diag.delaunay_vertices;
+  diag.nonmanifold_vertices = s.pinched;
+  diag.components = s.parts.size();
+  diag.triangles = s.tris.size() / 3;
+  diag.closed = diag.triangles > 0 && diag.boundary_edges == 0;
+  const uint64_t distinct = diag.delaunay_vertices;
   diag.samples_unused = distinct > used_vertices ? distinct - used_vertices : 0;
-  out.tris.swap(res);
 }
 
 } // namespace sc
@@ -1208,28 +1214,58 @@ double dist2(const double *x, const double *y) {
 
 } // namespace
 
-void drop_small_closed(std::vector<uint32_t> &tris, const Surface &s,
-                       size_t min_triangles, bool open_too) {
-  const size_t nt = tris.size() / 3;
+size_t drop_small_closed(const double *xyz, size_t n, Surface &s,
+                         size_t min_triangles, bool open_too,
+                         Progress &progress, sc_diag_t &diag) {
+  const size_t nt = s.tris.size() / 3, nc = s.parts.size();
   if (s.component.size() != nt || s.in_closed.size() != nt)
     throw Error(SC_EINTERNAL, "components out of step with the surface");
-  std::vector<size_t> count(s.component_genus.size(), 0);
-  for (size_t t = 0; t < nt; ++t)
-    ++count[s.component[t]];
-  std::vector<uint32_t> res;
-  res.reserve(tris.size());
-  for (size_t t = 0; t < nt; ++t)
-    if ((!s.in_closed[t] && !open_too) ||
-        count[s.component[t]] >= min_triangles)
-      res.insert(res.end(), &tris[3 * t], &tris[3 * t] + 3);
-  tris.swap(res);
+  std::vector<int32_t> renumber(nc, -1);
+  int32_t kept = 0;
+  for (size_t c = 0; c < nc; ++c)
+    if ((s.parts[c].boundary_edges != 0 && !open_too) ||
+        size_t(s.parts[c].faces) >= min_triangles)
+      renumber[c] = kept++;
+  if (size_t(kept) == nc)
+    return 0;
+  size_t k = 0;
+  for (size_t t = 0; t < nt; ++t) {
+    const int32_t c = renumber[s.component[t]];
+    if (c < 0)
+      continue;
+    std::memmove(&s.tris[3 * k], &s.tris[3 * t], 3 * sizeof(uint32_t));
+    s.component[k] = c;
+    s.in_closed[k] = s.in_closed[t];
+    ++k;
+  }
+  s.tris.resize(3 * k);
+  s.component.resize(k);
+  s.in_closed.resize(k);
+  if (s.pinched) {
+    // A pinched vertex may join components, and its count belongs to one
+    // of them: count again.
+    std::vector<uint32_t> tris;
+    tris.swap(s.tris);
+    describe(xyz, n, tris, progress, s, diag);
+  } else {
+    // Whole components went: every count of the others stands.
+    for (size_t c = 0; c < nc; ++c)
+      if (renumber[c] >= 0)
+        s.parts[size_t(renumber[c])] = s.parts[c];
+    s.parts.resize(size_t(kept));
+    summarise(s, diag);
+  }
+  return nt - k;
 }
 
-size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
-                      Progress &progress) {
+size_t attach_samples(const double *xyz, size_t n, Surface &surf,
+                      Progress &progress, sc_diag_t &diag) {
+  std::vector<uint32_t> &tris = surf.tris;
   size_t nt = tris.size() / 3;
   if (nt == 0)
     return 0;
+  if (surf.component.size() != nt || surf.in_closed.size() != nt)
+    throw Error(SC_EINTERNAL, "components out of step with the surface");
   std::vector<uint8_t> used(n, 0);
   for (uint32_t v : tris)
     used[v] = 1;
@@ -1286,6 +1322,9 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   }
 
   size_t attached = 0;
+  // Splits keep the counts of describe() but for the loop lengths, and
+  // where edges or vertices are not manifold: count again there.
+  bool recount = surf.pinched != 0 || diag.nonmanifold_edges != 0;
   std::vector<uint32_t> near;
   // Each triangle near a sample is looked at once, though it is in the
   // stars of three vertices.
@@ -1315,6 +1354,7 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
     // edge (farther samples are outliers and stay out).
     double best = std::numeric_limits<double>::infinity(), bw[3] = {0, 0, 0};
     uint32_t bt = UINT32_MAX;
+ 
     for (uint32_t t : near) {
       const uint32_t *v = &tris[3 * size_t(t)];
       const double *a = xyz + 3 * size_t(v[0]), *b = xyz + 3 * size_t(v[1]),
@@ -1364,13 +1404,22 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
       uint32_t t = uint32_t(tris.size() / 3);
       tris.push_back(a), tris.push_back(b), tris.push_back(c);
       gained[a].push_back(t), gained[b].push_back(t), gained[c].push_back(t);
+      surf.component.push_back(surf.component[bt]);
+      surf.in_closed.push_back(surf.in_closed[bt]);
       return t;
+    };
+    // Three triangles for one, or four for two: one more vertex, three
+    // more edges, two more triangles, in the component of the one split.
+    auto count_split = [&] {
+      Surface::Part &part = surf.parts[size_t(surf.component[bt])];
+      part.vertices += 1, part.edges += 3, part.faces += 2;
     };
     if (zero < 0) {
       set(bt, v[0], v[1], s);
       gained[s].push_back(bt);
       add(v[1], v[2], s);
       add(v[2], v[0], s);
+      count_split();
     } else {
       // The edge opposite the zero weight; at a corner, of the corner's two
       // edges the one whose other end is nearer the sample (edge c-(c+1)
@@ -1406,10 +1455,23 @@ size_t attach_samples(const double *xyz, size_t n, std::vector<uint32_t> &tris,
         set(other, b, s, d);
         gained[s].push_back(other);
         add(s, a, d);
+        count_split();
+      } else {
+        // A boundary edge split: its loop grows by an edge.
+        recount = true;
       }
     }
     used[s] = 1;
     ++attached;
+  }
+  if (attached == 0)
+    return 0;
+  if (recount) {
+    std::vector<uint32_t> res;
+    res.swap(tris);
+    describe(xyz, n, res, progress, surf, diag);
+  } else {
+    summarise(surf, diag);
   }
   return attached;
 }

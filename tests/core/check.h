@@ -30,6 +30,21 @@ static int check_failures;
     }                                                                          \
   } while (0)
 
+/* The counts a reconstruction reports in its diagnostics (d, an
+ * sc_diag_t) against those the mesh checker finds in the mesh (c, an
+ * sc_meshcheck_t); the core keeps some of them up to date as it edits the
+ * surface instead of counting again. */
+#define CHECK_DIAG_COUNTS(d, c)                                                \
+  do {                                                                         \
+    CHECK_EQ_INT((d).triangles, (c).faces);                                    \
+    CHECK_EQ_INT((d).components, (c).components);                              \
+    CHECK_EQ_INT((d).closed_components, (c).closed_components);                \
+    CHECK_EQ_INT((d).boundary_edges, (c).boundary_edges);                      \
+    CHECK_EQ_INT((d).euler, (c).euler);                                        \
+    CHECK_EQ_INT((d).genus, (c).genus_total);                                  \
+    CHECK_EQ_INT((d).samples_unused, (c).samples_unused);                      \
+  } while (0)
+
 #define CHECK_DONE()                                                           \
   (check_failures ? (fprintf(stderr, "%d check(s) failed\n", check_failures), \
                      1)                                                        \

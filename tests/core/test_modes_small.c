@@ -39,9 +39,7 @@ static void run(const char *what, const double *xyz, size_t n, int mode) {
   CHECK(c.oriented);
   CHECK_EQ_INT(m->diag.nonmanifold_edges, 0);
   CHECK_EQ_INT(m->diag.nonmanifold_vertices, 0);
-  CHECK_EQ_INT(m->diag.triangles, c.faces);
-  CHECK_EQ_INT(m->diag.components, c.components);
-  CHECK_EQ_INT(m->diag.samples_unused, c.samples_unused);
+  CHECK_DIAG_COUNTS(m->diag, c);
   if (mode == SC_MODE_WATERTIGHT && m->diag.path == SC_PATH_WATERTIGHT)
     CHECK(c.closed || c.faces == 0);
   /* Auto mode falls back to the cocone test when the detection finds too

@@ -297,7 +297,7 @@ int main(int argc, char **argv) {
   CHECK_EQ_INT(m->diag.nonmanifold_edges, 0);
   CHECK_EQ_INT(m->diag.nonmanifold_vertices, 0);
   CHECK_EQ_INT(m->diag.boundary_loops, c.boundary_loops);
-  CHECK_EQ_INT(m->diag.components, c.components);
+  CHECK_DIAG_COUNTS(m->diag, c);
 
   if (mode == SC_MODE_WATERTIGHT) {
     CHECK(c.closed);

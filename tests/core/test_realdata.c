@@ -65,6 +65,7 @@ int main(int argc, char **argv) {
   CHECK(c.samples_unused * 1000 <= pts.count);
   CHECK_EQ_INT(m->diag.genus, genus);
   CHECK(m->diag.closed);
+  CHECK_DIAG_COUNTS(m->diag, c);
   sc_meshcheck_free(&c);
   sc_mesh_free(m);
   sc_points_free(&pts);
