@@ -581,8 +581,11 @@ private:
     hull = {};
 
     size_t cells = dt_.number_of_cells(), k = 0;
+    // Per cell in the order visited: the links found below (2 bytes a
+    // cell, for the pass after the ratio test).
+    std::vector<uint16_t> cell_links(cells);
     V3 pole[4];
-    bool in_cone[4];
+    bool in_cone[4], grow_cone[4];
     for_cells(false, [&](auto c) {
       progress.tick(k++, 2 * cells);
       const float *ccc = c->info().cc;
@@ -594,34 +597,53 @@ private:
       // pole and the negative pole, which lie along the axis anyway, but
       // not for the extent of the cell in the cocone.
       V3 P[4];
+      double len[4][4]; // squared edge lengths
       double longest2 = 0;
       for (int j = 0; j < 4; ++j) {
         P[j] = v3(c->vertex(j)->point());
-        for (int i = 0; i < j; ++i)
-          longest2 = std::max(longest2, norm2(P[i] - P[j]));
+        for (int i = 0; i < j; ++i) {
+          len[i][j] = len[j][i] = norm2(P[i] - P[j]);
+          longest2 = std::max(longest2, len[i][j]);
+        }
       }
       const bool trusted = norm2(cc - P[0]) <= kMaxCentreRatio2 * longest2;
       for (int j = 0; j < 4; ++j) {
         VertexData &d = c->vertex(j)->info();
         for (int i = 0; i < 4; ++i)
           if (i != j)
-            d.nn2 = std::min(d.nn2, float(norm2(P[i] - P[j])));
+            d.nn2 = std::min(d.nn2, float(len[i][j]));
         pole[j] = {d.pole[0], d.pole[1], d.pole[2]};
         V3 dv = cc - P[j];
         double len2 = norm2(dv), dp = dot(dv, pole[j]);
         if (dp < 0 && float(len2) > d.h2)
           d.h2 = float(len2);
-        in_cone[j] = std::fabs(dp) <= sin_c * std::sqrt(len2);
+        const double reach = sin_c * std::sqrt(len2);
+        in_cone[j] = std::fabs(dp) <= reach;
+        // The growth below counts the cell as in the cocone unless it is
+        // clearly outside.
+        grow_cone[j] = !(std::fabs(dp) > reach);
         if (in_cone[j] && trusted && float(len2) > d.r2)
           d.r2 = float(len2);
       }
-      for (int j = 0; j < 4; ++j) {
-        if (!in_cone[j])
-          continue;
-        for (int i = 0; i < 4; ++i)
-          if (i != j && std::fabs(dot(pole[i], pole[j])) < cos_a)
-            c->vertex(j)->info().flags |= kVDisagree;
-      }
+      // Poles that agree, and the links the growth below may follow: bit
+      // 4 j + i when the circumcentre is in j's cocone and the poles of i
+      // and j agree.
+      uint16_t links = 0;
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < j; ++i) {
+          const double agree = std::fabs(dot(pole[i], pole[j]));
+          if (agree < cos_a) {
+            if (in_cone[j])
+              c->vertex(j)->info().flags |= kVDisagree;
+            if (in_cone[i])
+              c->vertex(i)->info().flags |= kVDisagree;
+          }
+          if (agree >= cos_a) {
+            links |= uint16_t(grow_cone[j]) << (4 * j + i);
+            links |= uint16_t(grow_cone[i]) << (4 * i + j);
+          }
+        }
+      cell_links[k - 1] = links;
     });
 
     // Growth from agreeing neighbours: a sample that passes the ratio test
@@ -659,32 +681,24 @@ private:
     std::vector<std::pair<uint32_t, uint32_t>> links;
     k = 0;
     for_cells(false, [&](auto c) {
+      const uint16_t mask = cell_links[k];
       progress.tick(cells + k++, 2 * cells);
-      Vh w[4];
+      if (!mask)
+        return;
+      uint32_t idx[4];
       bool any = false;
       for (int j = 0; j < 4; ++j) {
-        w[j] = c->vertex(j);
-        any = any || state[w[j]->info().idx] == 2;
+        idx[j] = c->vertex(j)->info().idx;
+        any = any || state[idx[j]] == 2;
       }
       if (!any)
         return;
-      const float *ccc = c->info().cc;
-      const V3 cc = {ccc[0], ccc[1], ccc[2]};
       for (int j = 0; j < 4; ++j) {
-        const VertexData &dv = w[j]->info();
-        if (state[dv.idx] == 0)
+        if (state[idx[j]] == 0)
           continue;
-        const V3 polev = {dv.pole[0], dv.pole[1], dv.pole[2]};
-        const V3 dir = cc - v3(w[j]->point());
-        if (std::fabs(dot(dir, polev)) > sin_c * std::sqrt(norm2(dir)))
-          continue;
-        for (int i = 0; i < 4; ++i) {
-          const VertexData &dq = w[i]->info();
-          if (i != j && state[dq.idx] == 2 &&
-              std::fabs(dot(polev, V3{dq.pole[0], dq.pole[1], dq.pole[2]})) >=
-                  cos_a)
-            links.emplace_back(dv.idx, dq.idx);
-        }
+        for (int i = 0; i < 4; ++i)
+          if (((mask >> (4 * j + i)) & 1) && state[idx[i]] == 2)
+            links.emplace_back(idx[j], idx[i]);
       }
     });
     std::vector<uint32_t> first(m + 1, 0), to(links.size());
@@ -698,6 +712,7 @@ private:
         to[fill[l.first]++] = l.second;
     }
     links = {};
+    cell_links = {};
     std::vector<uint32_t> grown;
     for (uint32_t v = 0; v < m; ++v)
       if (state[v] == 1 && first[v + 1] > first[v])
