@@ -8,6 +8,8 @@
 #include "shortcrust.h"
 
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -159,8 +161,10 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 // The topology of a finished surface: components, boundary loops, genus,
 // manifold checks; closed components facing inward are flipped. Resets and
 // fills the output fields of diag (triangles, boundary, components ...).
+// `table`, when given, is the edge table of tris (it saves building one).
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
-              Progress &progress, Surface &out, sc_diag_t &diag);
+              Progress &progress, Surface &out, sc_diag_t &diag,
+              const EdgeTable *table = nullptr);
 // Fills those fields of diag, and s.component_genus, from s.parts.
 void summarise(Surface &s, sc_diag_t &diag);
 // Puts the triangles in one order that depends only on the set: each
@@ -212,11 +216,12 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 // pieces), except the loops that boundary (which may be empty) marks as
 // where the surface ends. The patches together take at most max_work steps
 // of the dynamic programme (about L^3 / 6 for a loop of L edges); loops
-// beyond it stay.
+// beyond it stay. `table`, when given, is the edge table of tris.
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                 size_t max_loop, const std::vector<uint8_t> &boundary,
                 Progress &progress, sc_diag_t &diag,
-                uint64_t max_work = UINT64_MAX);
+                uint64_t max_work = UINT64_MAX,
+                const EdgeTable *table = nullptr);
 
 // One reconstruction, fed all at once or in chunks.
 class Recon {

@@ -493,15 +493,23 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
   const size_t L = loop.size(), half = L / 2, window = L / 8;
   double best = std::numeric_limits<double>::infinity();
   size_t bi = 0, bj = 0;
+  // The loop's points side by side, twice over, so that the window after
+  // any vertex is one run of the array: this search reads L^2 / 4 pairs.
+  std::vector<double> p(6 * L);
+  for (size_t i = 0; i < 2 * L; ++i)
+    std::memcpy(&p[3 * i], xyz + 3 * size_t(loop[i < L ? i : i - L]),
+                3 * sizeof(double));
   for (size_t i = 0; i < L; ++i) {
-    const double *a = xyz + 3 * size_t(loop[i]);
-    for (size_t d = half - window; d <= half + window; ++d) {
-      size_t j = (i + d) % L;
-      const double *b = xyz + 3 * size_t(loop[j]);
+    const double *a = &p[3 * i];
+    for (size_t j = i + half - window; j <= i + half + window; ++j) {
+      const double *b = &p[3 * j];
       double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
       double d2 = dx * dx + dy * dy + dz * dz;
-      if (d2 < best && loop[i] != loop[j] && !has_edge(loop[i], loop[j]))
-        best = d2, bi = i, bj = j;
+      if (d2 < best) {
+        const size_t jj = j < L ? j : j - L;
+        if (loop[i] != loop[jj] && !has_edge(loop[i], loop[jj]))
+          best = d2, bi = i, bj = jj;
+      }
     }
   }
   if (!(best < std::numeric_limits<double>::infinity()))
@@ -531,11 +539,16 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
 // result stays a manifold.
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
                 size_t max_loop, const std::vector<uint8_t> &boundary,
-                Progress &progress, sc_diag_t &diag, uint64_t max_work) {
+                Progress &progress, sc_diag_t &diag, uint64_t max_work,
+                const EdgeTable *table) {
   if (res.empty())
     return;
-  EdgeTable et;
-  et.build(xyz, n, res, progress, false);
+  EdgeTable own;
+  if (!table) {
+    own.build(xyz, n, res, progress, false);
+    table = &own;
+  }
+  const EdgeTable &et = *table;
   // Each vertex's neighbours along the surface's edges ...
   std::vector<uint32_t> adj_first(n + 1, 0), adj(2 * et.edges());
   for (size_t e = 0; e < et.edges(); ++e) {
@@ -960,9 +973,16 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     if (in[t])
       res.insert(res.end(), &otri[3 * t], &otri[3 * t] + 3);
   diag.walk_rejected = nl - res.size() / 3;
+  // The candidates' table, cut down to the output: the table of res (its
+  // triangles about each edge in angular order, which none of the passes
+  // below depends on).
+  et.keep_live(in);
+  const size_t walked = res.size();
   if (max_hole >= 3)
-    fill_holes(xyz, n, res, max_hole, boundary, progress, diag);
-  describe(xyz, n, res, progress, out, diag);
+    fill_holes(xyz, n, res, max_hole, boundary, progress, diag, UINT64_MAX,
+               &et);
+  describe(xyz, n, res, progress, out, diag,
+           res.size() == walked ? &et : nullptr);
 }
 
 void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
@@ -970,22 +990,43 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
     uint32_t v[3];
   };
   const size_t nt = tris.size() / 3;
-  std::vector<Tri> t(nt);
-  for (size_t i = 0; i < nt; ++i) {
-    uint32_t *v = t[i].v;
+  auto normalised = [&](size_t i) {
+    Tri x;
     const uint32_t *s = &tris[3 * i];
     if (keep_orientation) {
       int k = s[0] < s[1] ? (s[0] < s[2] ? 0 : 2) : (s[1] < s[2] ? 1 : 2);
       for (int j = 0; j < 3; ++j)
-        v[j] = s[(k + j) % 3];
+        x.v[j] = s[(k + j) % 3];
     } else {
-      std::copy(s, s + 3, v);
-      std::sort(v, v + 3);
+      std::copy(s, s + 3, x.v);
+      std::sort(x.v, x.v + 3);
+    }
+    return x;
+  };
+  // Either way each triangle starts at its smallest vertex: a counting
+  // sort on that vertex, then a sort of each vertex's few triangles.
+  uint32_t top = 0;
+  for (uint32_t v : tris)
+    top = std::max(top, v);
+  std::vector<uint32_t> start(nt ? size_t(top) + 2 : 1, 0);
+  for (size_t i = 0; i < nt; ++i)
+    ++start[size_t(normalised(i).v[0]) + 1];
+  for (size_t v = 0; v + 1 < start.size(); ++v)
+    start[v + 1] += start[v];
+  std::vector<Tri> t(nt);
+  {
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < nt; ++i) {
+      const Tri x = normalised(i);
+      t[fill[x.v[0]]++] = x;
     }
   }
-  std::sort(t.begin(), t.end(), [](const Tri &a, const Tri &b) {
-    return std::lexicographical_compare(a.v, a.v + 3, b.v, b.v + 3);
-  });
+  for (size_t v = 0; v + 1 < start.size(); ++v)
+    if (start[v + 1] - start[v] > 1)
+      std::sort(t.begin() + start[v], t.begin() + start[v + 1],
+                [](const Tri &a, const Tri &b) {
+                  return a.v[1] != b.v[1] ? a.v[1] < b.v[1] : a.v[2] < b.v[2];
+                });
   for (size_t i = 0; i < nt; ++i)
     std::memcpy(&tris[3 * i], t[i].v, sizeof t[i].v);
 }
@@ -1009,10 +1050,15 @@ void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 }
 
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
-              Progress &progress, Surface &out, sc_diag_t &diag) {
+              Progress &progress, Surface &out, sc_diag_t &diag,
+              const EdgeTable *table) {
   const size_t nr = res.size() / 3;
-  EdgeTable rt;
-  rt.build(xyz, n, res, progress, false);
+  EdgeTable own;
+  if (!table) {
+    own.build(xyz, n, res, progress, false);
+    table = &own;
+  }
+  const EdgeTable &rt = *table;
   // A final check of vertex-manifoldness on the result, counted honestly:
   // the corners of triangles at a vertex that share an edge there are one
   // fan; a vertex with two fans is pinched. (Before any triangle is
