@@ -308,7 +308,7 @@ public:
 
   void filter(const double *xyz, size_t n, const sc_params_t &params,
               Progress &progress, Filtered &out, sc_diag_t &diag,
-              double seconds[SC_STAGE_COUNT], bool keep) override {
+              double seconds[SC_STAGE_COUNT]) override {
     Stopwatch sw;
     progress.stage(SC_STAGE_DELAUNAY);
     resolve_duplicates(xyz, n, out.dups);
@@ -334,8 +334,7 @@ public:
     diag.candidates = out.tris.size() / 3;
     // The triangulation is not needed any more: free it before pruning so
     // that the peak memory is the triangulation's alone.
-    if (!keep)
-      dt_.clear();
+    dt_.clear();
     // Which cell reports a facet, and when, depends on heap addresses; the
     // later stages break ties by the order of the candidates. They carry no
     // orientation: the walk gives them one.

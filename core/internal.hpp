@@ -101,11 +101,13 @@ public:
                       Progress &progress) = 0;
   virtual int dimension() const = 0;
   // Resolves duplicates, then runs poles and candidates, filling diag.
-  // Frees the triangulation at the end unless `keep`.
+  // Frees the triangulation at the end.
   virtual void filter(const double *xyz, size_t n, const sc_params_t &params,
                       Progress &progress, Filtered &out, sc_diag_t &diag,
-                      double seconds[SC_STAGE_COUNT], bool keep) = 0;
-  // Watertight mode, on a triangulation kept by filter(): labels the cells
+                      double seconds[SC_STAGE_COUNT]) = 0;
+  // Watertight mode, on a triangulation of the surface's (distinct) points
+  // inserted in the order of its vertex numbers, without filter(): labels
+  // the cells
   // inside or outside across the oriented surface tris (vertex numbers) and
   // replaces tris by the boundary of the inside cells, repaired into a
   // 2-manifold as far as relabelling goes (a few pinched vertices may be

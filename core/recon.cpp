@@ -29,6 +29,19 @@ constexpr uint64_t kMaxFillWork = 2000000000ull;
 // the surface, are bubbles between scan layers in the modes for scans.
 constexpr size_t kMinBubble = 8;
 
+// The box of n points (min x, y, z, then max x, y, z).
+void bounding_box(const double *xyz, size_t n, double box[6]) {
+  for (int k = 0; k < 3; ++k) {
+    box[k] = std::numeric_limits<double>::infinity();
+    box[3 + k] = -std::numeric_limits<double>::infinity();
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      box[k] = std::min(box[k], xyz[3 * i + k]);
+      box[3 + k] = std::max(box[3 + k], xyz[3 * i + k]);
+    }
+}
+
 void check_finite(const double *xyz, size_t n, size_t first) {
   for (size_t i = 0; i < 3 * n; ++i) {
     if (!std::isfinite(xyz[i])) {
@@ -94,7 +107,6 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
         .insert((surf.in_closed[t] ? closed_part : open).end(),
                 &surf.tris[3 * t], &surf.tris[3 * t] + 3);
   if (open.empty()) {
-    dt_.reset();
     diag.path = SC_PATH_WATERTIGHT;
     return;
   }
@@ -129,8 +141,15 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   sc_diag_t da = diag;
   bool have_labels = false;
   if (!Closure(db).ok) {
+    // The triangulation went after the candidates, for it is most of the
+    // memory and the patches close every scan measured: build it again
+    // over the same points, numbered as the surface's vertices are.
+    double box[6];
+    bounding_box(lxyz, m, box);
+    std::unique_ptr<Triangulator> dt = make_triangulator(params_.threads, box);
+    dt->insert(lxyz, 0, m, progress);
     std::vector<uint32_t> labelled = open;
-    have_labels = dt_->close(labelled, progress, da);
+    have_labels = dt->close(labelled, progress, da);
     canonical_order(labelled, true);
     if (have_labels) {
       labelled.insert(labelled.end(), closed_part.begin(), closed_part.end());
@@ -146,7 +165,6 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
       drop_debris(a, da);
     }
   }
-  dt_.reset();
   const uint64_t relabelled = da.cells_relabelled;
 
   if (have_labels && !Closure(db).better_than(Closure(da))) {
@@ -179,17 +197,8 @@ void Recon::insert_range(size_t first, size_t n) {
     return;
   Progress progress(params_.progress, params_.progress_user);
   if (!dt_) {
-    double box[6] = {std::numeric_limits<double>::infinity(),
-                     std::numeric_limits<double>::infinity(),
-                     std::numeric_limits<double>::infinity(),
-                     -std::numeric_limits<double>::infinity(),
-                     -std::numeric_limits<double>::infinity(),
-                     -std::numeric_limits<double>::infinity()};
-    for (size_t i = first; i < first + n; ++i)
-      for (int k = 0; k < 3; ++k) {
-        box[k] = std::min(box[k], xyz_[3 * i + k]);
-        box[3 + k] = std::max(box[3 + k], xyz_[3 * i + k]);
-      }
+    double box[6];
+    bounding_box(xyz_ + 3 * first, n, box);
     dt_ = make_triangulator(params_.threads, box);
   }
   Stopwatch sw;
@@ -250,9 +259,8 @@ sc_mesh_t *Recon::finish() {
 
   Filtered f;
   const bool watertight = params_.mode == SC_MODE_WATERTIGHT;
-  dt_->filter(xyz_, n_, params_, progress, f, diag, seconds_, watertight);
-  if (!watertight)
-    dt_.reset();
+  dt_->filter(xyz_, n_, params_, progress, f, diag, seconds_);
+  dt_.reset();
   diag.path = params_.mode == SC_MODE_SHORTCRUST ? SC_PATH_SHORTCRUST
               : params_.mode == SC_MODE_COCONE   ? SC_PATH_COCONE
                                                  : SC_PATH_BOUNDARY;

@@ -61,9 +61,11 @@ typedef enum sc_mode {
    * made only at interior vertices, and no edge at a boundary sample is
    * pruned, so the output is a 2-manifold with boundary. */
   SC_MODE_BOUNDARY = 2,
-  /* Boundary mode, then holes are closed by labelling the Delaunay cells
-   * inside or outside across the surface: the output is the boundary of the
-   * inside cells, a closed 2-manifold. */
+  /* Boundary mode, then every hole is closed: handles that closed round a
+   * hole are cut, each boundary loop gets a least-area patch, and where
+   * the patches cannot close the surface the Delaunay cells are labelled
+   * inside or outside across it and the boundary of the inside cells is
+   * taken. The output is a closed 2-manifold. */
   SC_MODE_WATERTIGHT = 3,
   /* For input not known to be closed: the cocone test where the samples
    * look like a closed surface, boundary mode where they do not (diag.path
@@ -168,8 +170,8 @@ typedef struct sc_diag {
   double seconds[SC_STAGE_COUNT]; /* wall time per stage */
   double seconds_total;
   /* The path taken, one of the SC_PATH_ values below: what auto mode chose,
-   * and whether watertight mode closed the surface by labelling cells or had
-   * to fall back to filling holes. */
+   * and whether watertight mode closed the surface with patches or had to
+   * label cells. */
   int path;
   uint64_t boundary_samples;  /* samples found not interior (0 in the
                                  shortcrust and cocone modes) */
@@ -191,8 +193,9 @@ typedef enum sc_path {
   SC_PATH_SHORTCRUST = 0,      /* the paper's criteria */
   SC_PATH_COCONE = 1,          /* the cocone test everywhere */
   SC_PATH_BOUNDARY = 2,        /* the cocone test at interior samples only */
-  SC_PATH_WATERTIGHT = 3,      /* closed by labelling cells */
-  SC_PATH_WATERTIGHT_FILL = 4, /* labelling failed; holes filled instead */
+  SC_PATH_WATERTIGHT = 3,      /* closed by labelling cells (or nothing
+                                  was open) */
+  SC_PATH_WATERTIGHT_FILL = 4, /* closed by patches over the holes */
   SC_PATH_COUNT_
 } sc_path_t;
 
