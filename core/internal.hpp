@@ -8,8 +8,6 @@
 #include "shortcrust.h"
 
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
