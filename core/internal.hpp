@@ -135,6 +135,15 @@ struct Surface {
   };
   std::vector<Part> parts;
   uint64_t pinched = 0;
+  // The boundary loops (loops that touch at a vertex are one): each one's
+  // component (-1 once dropped) and length in edges, and each boundary
+  // vertex's loop (UINT32_MAX for the others).
+  struct Loop {
+    int32_t part;
+    uint64_t length;
+  };
+  std::vector<Loop> loops;
+  std::vector<uint32_t> loop_of;
 };
 // The candidates' edges with their triangles in order about each edge
 // (surface.cpp): pruning builds it, extraction takes it over.
@@ -167,6 +176,8 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
               const EdgeTable *table = nullptr);
 // Fills those fields of diag, and s.component_genus, from s.parts.
 void summarise(Surface &s, sc_diag_t &diag);
+// Counts s.loops into s.parts (loops, the longest, loops by length).
+void tally_loops(Surface &s);
 // Puts the triangles in one order that depends only on the set: each
 // rotated to start at its smallest vertex number (keep_orientation) or with
 // its numbers ascending, then all sorted. Which Delaunay cell reports a

@@ -1119,6 +1119,8 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
       vcomp[res[3 * t + k]] = comp_of[t];
   // Loops, and their lengths in boundary edges (loops that touch at a
   // vertex count as one).
+  std::vector<Surface::Loop> loops;
+  std::vector<uint32_t> loop_of(n, UINT32_MAX);
   {
     std::vector<uint64_t> loop_edges(n, 0);
     for (size_t e = 0; e < rt.edges(); ++e)
@@ -1127,15 +1129,18 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
     for (uint32_t v = 0; v < n; ++v) {
       if (vcomp[v] < 0)
         continue;
-      Surface::Part &p = parts[vcomp[v]];
-      ++p.vertices;
-      const uint64_t len = loop_edges[v];
-      if (len == 0)
+      ++parts[vcomp[v]].vertices;
+      if (loop_edges[v] == 0)
         continue;
-      ++p.loops;
-      p.longest_loop = std::max(p.longest_loop, len);
-      ++p.loops_by_length[len <= 10 ? 0 : len <= 100 ? 1 : len <= 1000 ? 2 : 3];
+      loop_of[v] = uint32_t(loops.size());
+      loops.push_back({vcomp[v], loop_edges[v]});
     }
+    for (size_t e = 0; e < rt.edges(); ++e)
+      if (rt.first[e + 1] - rt.first[e] == 1) {
+        const uint64_t k = rt.entries[rt.first[e]].key;
+        for (uint32_t u : {key_lo(k), uint32_t(k)})
+          loop_of[u] = loop_of[bloops.find(u)];
+      }
   }
   // Signed volumes about each component's first vertex, for precision.
   std::vector<double> vol(nc, 0.0);
@@ -1158,8 +1163,30 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
   out.component.swap(comp_of);
   out.parts.swap(parts);
   out.pinched = pinched;
+  out.loops.swap(loops);
+  out.loop_of.swap(loop_of);
   out.tris.swap(res);
+  tally_loops(out);
   summarise(out, diag);
+}
+
+void tally_loops(Surface &s) {
+  for (Surface::Part &p : s.parts) {
+    p.loops = p.longest_loop = 0;
+    for (uint64_t &l : p.loops_by_length)
+      l = 0;
+  }
+  for (const Surface::Loop &l : s.loops) {
+    if (l.part < 0)
+      continue;
+    Surface::Part &p = s.parts[size_t(l.part)];
+    ++p.loops;
+    p.longest_loop = std::max(p.longest_loop, l.length);
+    ++p.loops_by_length[l.length <= 10     ? 0
+                        : l.length <= 100  ? 1
+                        : l.length <= 1000 ? 2
+                                           : 3];
+  }
 }
 
 void summarise(Surface &s, sc_diag_t &diag) {
@@ -1299,6 +1326,8 @@ size_t drop_small_closed(const double *xyz, size_t n, Surface &s,
       if (renumber[c] >= 0)
         s.parts[size_t(renumber[c])] = s.parts[c];
     s.parts.resize(size_t(kept));
+    for (Surface::Loop &l : s.loops)
+      l.part = l.part < 0 ? -1 : renumber[size_t(l.part)];
     summarise(s, diag);
   }
   return nt - k;
@@ -1368,9 +1397,11 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
   }
 
   size_t attached = 0;
-  // Splits keep the counts of describe() but for the loop lengths, and
-  // where edges or vertices are not manifold: count again there.
+  // Each split below keeps the counts of describe() up to date (one across
+  // a boundary edge makes its loop an edge longer); where edges or
+  // vertices are not manifold, count again instead.
   bool recount = surf.pinched != 0 || diag.nonmanifold_edges != 0;
+  bool loops_grew = false;
   std::vector<uint32_t> near;
   // Each triangle near a sample is looked at once, though it is in the
   // stars of three vertices.
@@ -1503,8 +1534,21 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
         add(s, a, d);
         count_split();
       } else {
-        // A boundary edge split: its loop grows by an edge.
-        recount = true;
+        // A boundary edge split: one more vertex, two more edges (one of
+        // them on the boundary), one more triangle, and its loop is an
+        // edge longer.
+        const uint32_t l = a < surf.loop_of.size() ? surf.loop_of[a]
+                                                   : UINT32_MAX;
+        if (l == UINT32_MAX) {
+          recount = true;
+        } else {
+          Surface::Part &part = surf.parts[size_t(surf.component[bt])];
+          part.vertices += 1, part.edges += 2, part.faces += 1;
+          part.boundary_edges += 1;
+          ++surf.loops[l].length;
+          surf.loop_of[s] = l;
+          loops_grew = true;
+        }
       }
     }
     used[s] = 1;
@@ -1517,6 +1561,8 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     res.swap(tris);
     describe(xyz, n, res, progress, surf, diag);
   } else {
+    if (loops_grew)
+      tally_loops(surf);
     summarise(surf, diag);
   }
   return attached;
