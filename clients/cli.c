@@ -331,10 +331,10 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
   fprintf(f,
           ", \"r\": %.17g, \"cocone_theta\": %.17g, \"paper_pruning\": %d, "
           "\"max_hole_edges\": %d, \"threads\": %d, \"boundary_rho\": %.17g, "
-          "\"boundary_alpha\": %.17g},\n",
+          "\"boundary_alpha\": %.17g, \"watertight_labels\": %d},\n",
           r->params.r, r->params.cocone_theta, r->params.paper_pruning,
           r->params.max_hole_edges, r->params.threads, r->params.boundary_rho,
-          r->params.boundary_alpha);
+          r->params.boundary_alpha, r->params.watertight_labels);
 #define U64_(field) fprintf(f, "  \"" #field "\": %llu,\n", (unsigned long long)d->field)
   U64_(points_in);
   U64_(duplicates_merged);

@@ -32,6 +32,12 @@ static void usage(FILE *f) {
           "(default %d)\n"
           "      --paper-pruning   prune every edge with a single candidate, "
           "as in the paper\n"
+          "      --labels          watertight mode: close the surface by "
+          "labelling Delaunay\n"
+          "                        cells inside or outside first (default: "
+          "least-area\n"
+          "                        patches first, labelling where they "
+          "cannot close it)\n"
           "      --rho RHO         boundary detection: ratio of cocone extent "
           "to pole height,\n"
           "                        in (0, 10] (default %g)\n"
@@ -50,12 +56,19 @@ static void usage(FILE *f) {
         f);
 }
 
-enum { OPT_MAX_HOLE = SC_CLI_OPT_OWN, OPT_PAPER, OPT_RHO, OPT_ALPHA };
+enum {
+  OPT_MAX_HOLE = SC_CLI_OPT_OWN,
+  OPT_PAPER,
+  OPT_RHO,
+  OPT_ALPHA,
+  OPT_LABELS
+};
 
 static const struct option long_options[] = {
     SC_CLI_JOB_LONG_OPTIONS,
     {"max-hole", required_argument, NULL, OPT_MAX_HOLE},
     {"paper-pruning", no_argument, NULL, OPT_PAPER},
+    {"labels", no_argument, NULL, OPT_LABELS},
     {"rho", required_argument, NULL, OPT_RHO},
     {"alpha", required_argument, NULL, OPT_ALPHA},
     {"threads", required_argument, NULL, 'j'},
@@ -86,6 +99,9 @@ int sc_cmd_reconstruct(int argc, char **argv) {
       break;
     case OPT_PAPER:
       params->paper_pruning = 1;
+      break;
+    case OPT_LABELS:
+      params->watertight_labels = 1;
       break;
     case OPT_RHO:
       if (sc_cli_parse_double("--rho", optarg, &params->boundary_rho) < 0)

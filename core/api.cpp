@@ -117,6 +117,11 @@ int check_params(const sc_params_t *p, char *msg, size_t len) {
             p->boundary_alpha);
     return SC_EINVALID_ARGUMENT;
   }
+  if (p->watertight_labels != 0 && p->watertight_labels != 1) {
+    set_msg(msg, len, "watertight_labels must be 0 or 1, got %d",
+            p->watertight_labels);
+    return SC_EINVALID_ARGUMENT;
+  }
   if (p->threads < 0) {
     set_msg(msg, len, "threads must be >= 0, got %d", p->threads);
     return SC_EINVALID_ARGUMENT;

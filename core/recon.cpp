@@ -132,15 +132,20 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   // The surface was described after extraction, and cutting handles only
   // takes triangles out of open components: no component to flip, and
   // describe() runs once the holes are filled.
-  b.tris.swap(surf.tris);
-  fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork);
-  describe(lxyz, m, b.tris, progress, b, db);
-  drop_debris(b, db);
+  auto patch = [&] {
+    b.tris.swap(surf.tris);
+    fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork);
+    describe(lxyz, m, b.tris, progress, b, db);
+    drop_debris(b, db);
+  };
+  const bool labels_first = params_.watertight_labels != 0;
+  if (!labels_first)
+    patch();
 
   Surface a;
   sc_diag_t da = diag;
   bool have_labels = false;
-  if (!Closure(db).ok) {
+  if (labels_first || !Closure(db).ok) {
     // The triangulation went after the candidates, for it is most of the
     // memory and the patches close every scan measured: build it again
     // over the same points, numbered as the surface's vertices are.
@@ -166,8 +171,11 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
     }
   }
   const uint64_t relabelled = da.cells_relabelled;
+  if (labels_first && !have_labels)
+    patch();
 
-  if (have_labels && !Closure(db).better_than(Closure(da))) {
+  if (have_labels &&
+      (labels_first || !Closure(db).better_than(Closure(da)))) {
     surf = std::move(a);
     diag = da;
     diag.path = SC_PATH_WATERTIGHT;

@@ -137,6 +137,12 @@ typedef struct sc_params {
    * them (unoriented) is at most this, radians, in (0, pi/2]; default
    * pi/9 (20 degrees); 0 means the default. */
   double boundary_alpha;
+  /* Watertight mode: 0 (default) closes the holes with least-area patches
+   * and labels the Delaunay cells only where the patches cannot close the
+   * surface; 1 labels the cells first (inside or outside across the
+   * surface; the output is the boundary of the inside cells) and patches
+   * only when no cell comes out inside. */
+  int watertight_labels;
 } sc_params_t;
 
 /* Fills *p with the documented defaults. */

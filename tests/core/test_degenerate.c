@@ -102,6 +102,8 @@ int main(void) {
   expect_error("max_hole_edges -1", pts, 400, &q, SC_EINVALID_ARGUMENT);
   q = p, q.paper_pruning = 2;
   expect_error("paper_pruning 2", pts, 400, &q, SC_EINVALID_ARGUMENT);
+  q = p, q.watertight_labels = -1;
+  expect_error("watertight_labels -1", pts, 400, &q, SC_EINVALID_ARGUMENT);
 
   /* The smallest valid inputs do not fail: a tetrahedron gives a closed
    * tetrahedron or nothing, never something non-manifold. */

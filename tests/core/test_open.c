@@ -245,8 +245,11 @@ int main(int argc, char **argv) {
   for (int i = 0; i < OPEN_COUNT; ++i)
     if (strcmp(argv[1], open_names[i]) == 0)
       s = i;
+  /* "labels": watertight mode that labels cells before it patches. */
+  const int labels = strcmp(argv[2], "labels") == 0;
   int mode = strcmp(argv[2], "boundary") == 0     ? SC_MODE_BOUNDARY
              : strcmp(argv[2], "watertight") == 0 ? SC_MODE_WATERTIGHT
+             : labels                             ? SC_MODE_WATERTIGHT
              : strcmp(argv[2], "auto") == 0       ? SC_MODE_AUTO
                                                   : -1;
   size_t want = strtoul(argv[3], NULL, 10);
@@ -266,6 +269,7 @@ int main(int argc, char **argv) {
   sc_params_t p;
   sc_params_init(&p);
   p.mode = (sc_mode_t)mode;
+  p.watertight_labels = labels;
   sc_mesh_t *m = NULL;
   char msg[256] = "";
   double t0 = sc_ts_seconds();
@@ -306,6 +310,8 @@ int main(int argc, char **argv) {
     CHECK(m->diag.closed);
     CHECK(m->diag.path == SC_PATH_WATERTIGHT ||
           m->diag.path == SC_PATH_WATERTIGHT_FILL);
+    if (labels)
+      CHECK_EQ_INT(m->diag.path, SC_PATH_WATERTIGHT);
     /* Closing may bury a sample or two of the rim inside. */
     CHECK(c.samples_unused * 100 <= n);
   } else {
