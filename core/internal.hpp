@@ -105,8 +105,8 @@ public:
                       double seconds[SC_STAGE_COUNT]) = 0;
   // Watertight mode, on a triangulation of the surface's (distinct) points
   // inserted in the order of its vertex numbers, without filter(): labels
-  // the cells
-  // inside or outside across the oriented surface tris (vertex numbers) and
+  // the cells inside or outside across the oriented surface tris (vertex
+  // numbers) and
   // replaces tris by the boundary of the inside cells, repaired into a
   // 2-manifold as far as relabelling goes (a few pinched vertices may be
   // left). Returns false, leaving tris as it was, when no cell is inside.
@@ -124,7 +124,6 @@ struct Surface {
   std::vector<uint32_t> tris;
   std::vector<int32_t> component_genus; // per component, -1 when open
   std::vector<int32_t> component;       // per triangle: its component
-  std::vector<uint8_t> in_closed; // per triangle: its component is closed
   // What describe() counted in each component, so that dropping whole
   // components or splitting triangles need not count again. The vertex
   // counts are per component only when no vertex is pinched.
@@ -144,6 +143,10 @@ struct Surface {
   };
   std::vector<Loop> loops;
   std::vector<uint32_t> loop_of;
+  // Whether triangle t's component is closed.
+  bool in_closed(size_t t) const {
+    return parts[size_t(component[t])].boundary_edges == 0;
+  }
 };
 // The candidates' edges with their triangles in order about each edge
 // (surface.cpp): pruning builds it, extraction takes it over.

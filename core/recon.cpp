@@ -103,8 +103,8 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   const uint64_t loops = diag.boundary_loops, before = diag.triangles;
   std::vector<uint32_t> open, closed_part;
   for (size_t t = 0; t < surf.tris.size() / 3; ++t)
-    (surf.in_closed[t] ? closed_part : open)
-        .insert((surf.in_closed[t] ? closed_part : open).end(),
+    (surf.in_closed(t) ? closed_part : open)
+        .insert((surf.in_closed(t) ? closed_part : open).end(),
                 &surf.tris[3 * t], &surf.tris[3 * t] + 3);
   if (open.empty()) {
     diag.path = SC_PATH_WATERTIGHT;
@@ -147,8 +147,8 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   bool have_labels = false;
   if (labels_first || !Closure(db).ok) {
     // The triangulation went after the candidates, for it is most of the
-    // memory and the patches close every scan measured: build it again
-    // over the same points, numbered as the surface's vertices are.
+    // memory (and the patches alone close every scan measured): build it
+    // again over the same points, numbered as the surface's vertices are.
     double box[6];
     bounding_box(lxyz, m, box);
     std::unique_ptr<Triangulator> dt = make_triangulator(params_.threads, box);

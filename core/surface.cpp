@@ -1157,9 +1157,6 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
       std::swap(res[3 * t + 1], res[3 * t + 2]);
   }
 
-  out.in_closed.assign(nr, 0);
-  for (size_t t = 0; t < nr; ++t)
-    out.in_closed[t] = parts[comp_of[t]].boundary_edges == 0;
   out.component.swap(comp_of);
   out.parts.swap(parts);
   out.pinched = pinched;
@@ -1291,7 +1288,7 @@ size_t drop_small_closed(const double *xyz, size_t n, Surface &s,
                          size_t min_triangles, bool open_too,
                          Progress &progress, sc_diag_t &diag) {
   const size_t nt = s.tris.size() / 3, nc = s.parts.size();
-  if (s.component.size() != nt || s.in_closed.size() != nt)
+  if (s.component.size() != nt)
     throw Error(SC_EINTERNAL, "components out of step with the surface");
   std::vector<int32_t> renumber(nc, -1);
   int32_t kept = 0;
@@ -1308,12 +1305,10 @@ size_t drop_small_closed(const double *xyz, size_t n, Surface &s,
       continue;
     std::memmove(&s.tris[3 * k], &s.tris[3 * t], 3 * sizeof(uint32_t));
     s.component[k] = c;
-    s.in_closed[k] = s.in_closed[t];
     ++k;
   }
   s.tris.resize(3 * k);
   s.component.resize(k);
-  s.in_closed.resize(k);
   if (s.pinched) {
     // A pinched vertex may join components, and its count belongs to one
     // of them: count again.
@@ -1339,7 +1334,7 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
   size_t nt = tris.size() / 3;
   if (nt == 0)
     return 0;
-  if (surf.component.size() != nt || surf.in_closed.size() != nt)
+  if (surf.component.size() != nt)
     throw Error(SC_EINTERNAL, "components out of step with the surface");
   std::vector<uint8_t> used(n, 0);
   for (uint32_t v : tris)
@@ -1431,7 +1426,6 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     // edge (farther samples are outliers and stay out).
     double best = std::numeric_limits<double>::infinity(), bw[3] = {0, 0, 0};
     uint32_t bt = UINT32_MAX;
- 
     for (uint32_t t : near) {
       const uint32_t *v = &tris[3 * size_t(t)];
       const double *a = xyz + 3 * size_t(v[0]), *b = xyz + 3 * size_t(v[1]),
@@ -1482,7 +1476,6 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
       tris.push_back(a), tris.push_back(b), tris.push_back(c);
       gained[a].push_back(t), gained[b].push_back(t), gained[c].push_back(t);
       surf.component.push_back(surf.component[bt]);
-      surf.in_closed.push_back(surf.in_closed[bt]);
       return t;
     };
     // Three triangles for one, or four for two: one more vertex, three
