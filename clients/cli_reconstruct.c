@@ -140,6 +140,8 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   sc_mesh_format_t fmt;
   sc_points_t pts;
   double t_read;
+  /* A hint, before the first large allocation; see shortcrust.h. */
+  (void)sc_tune_allocator();
   int status = sc_cli_job_read(&o, &progress, &fmt, &pts, &t_read);
   if (status != SC_EXIT_OK)
     return status;

@@ -5,12 +5,17 @@
 
 #include "internal.hpp"
 
+#include <climits>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <new>
 #include <stdexcept>
+
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 extern "C" const char *sc_strerror(int code) {
   switch (code) {
@@ -252,4 +257,14 @@ extern "C" void sc_mesh_free(sc_mesh_t *mesh) {
 
 extern "C" uint64_t sc_estimate_bytes(uint64_t n) {
   return sc::kBytesPerPoint * n + (1u << 20);
+}
+
+extern "C" int sc_tune_allocator(void) {
+#ifdef __GLIBC__
+  // Large blocks from the heap rather than from mmap(), and the heap's top
+  // kept when freed: a later allocation reuses pages already faulted in.
+  if (mallopt(M_MMAP_MAX, 0) == 1 && mallopt(M_TRIM_THRESHOLD, INT_MAX) == 1)
+    return SC_OK;
+#endif
+  return SC_EINTERNAL;
 }

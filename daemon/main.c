@@ -259,5 +259,8 @@ int main(int argc, char **argv) {
   if (rc != 0)
     return rc > 0 ? 0 : 2;
   scd_log_init(cfg.log_level);
+  /* Jobs reuse the memory earlier jobs freed; the server gives it back to
+   * the system when it has been idle for a moment (see server.c). */
+  (void)sc_tune_allocator();
   return scd_server_run(&cfg);
 }

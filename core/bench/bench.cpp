@@ -230,6 +230,7 @@ void print_row(const char *name, const Result &r, size_t n) {
 } // namespace
 
 int main(int argc, char **argv) {
+  (void)sc_tune_allocator(); // as the command line does
   std::vector<size_t> sizes{100000, 1000000};
   int surface = SC_SURF_TORUS, density = SC_DENSITY_UNIFORM_RANDOM;
   int threads = int(std::thread::hardware_concurrency());
