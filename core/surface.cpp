@@ -11,7 +11,6 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
-#include <unordered_map>
 
 namespace sc {
 namespace {
@@ -1360,11 +1359,29 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
       if (has(t, v))
         visit(t);
   };
+  // reach[v]: at least the longest edge of every triangle that has had
+  // vertex v. Every point of a triangle is within its longest edge of each
+  // of its corners, so a vertex farther from a sample than twice its reach
+  // has no triangle the sample may join, and one farther than its reach
+  // plus the distance to the best triangle so far has no nearer one.
+  std::vector<double> reach(n, 0.0);
+  auto reaches = [&](uint32_t t) {
+    const uint32_t *v = &tris[3 * size_t(t)];
+    double l = 0;
+    for (int k = 0; k < 3; ++k)
+      l = std::max(l, dist2(xyz + 3 * size_t(v[k]),
+                            xyz + 3 * size_t(v[(k + 1) % 3])));
+    l = std::sqrt(l);
+    for (int k = 0; k < 3; ++k)
+      reach[v[k]] = std::max(reach[v[k]], l);
+  };
   double edge_sum = 0;
-  for (size_t t = 0; t < nt; ++t)
+  for (size_t t = 0; t < nt; ++t) {
     for (int k = 0; k < 3; ++k)
       edge_sum += std::sqrt(dist2(xyz + 3 * size_t(tris[3 * t + k]),
                                   xyz + 3 * size_t(tris[3 * t + (k + 1) % 3])));
+    reaches(uint32_t(t));
+  }
   const double cell = 2 * edge_sum / double(3 * nt);
   if (!(cell > 0))
     return 0;
@@ -1381,14 +1398,28 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     if (used[v])
       grid.emplace_back(key(xyz + 3 * size_t(v), 0, 0, 0), v);
   std::sort(grid.begin(), grid.end());
-  // Where each cell's run of the grid is: one hash lookup per cell looked
-  // at, not a binary search over the whole grid.
-  std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> runs;
-  runs.reserve(grid.size());
+  // Where each cell's run of the grid is, in a flat table with linear
+  // probing: one lookup per cell looked at, which mostly finds the slot the
+  // previous sample found (a node-based map cost a cache miss each time).
+  struct Run {
+    uint64_t key;
+    uint32_t first, last; // last == 0: an empty slot
+  };
+  size_t slots = 16;
+  while (slots < 2 * grid.size())
+    slots *= 2;
+  std::vector<Run> runs(slots, Run{0, 0, 0});
+  const size_t mask = slots - 1;
+  auto slot = [&](uint64_t k) {
+    size_t h = size_t((k * 0x9E3779B97F4A7C15ull) >> 32) & mask;
+    while (runs[h].last != 0 && runs[h].key != k)
+      h = (h + 1) & mask;
+    return h;
+  };
   for (size_t i = 0, j; i < grid.size(); i = j) {
     for (j = i + 1; j < grid.size() && grid[j].first == grid[i].first; ++j) {
     }
-    runs.emplace(grid[i].first, std::make_pair(uint32_t(i), uint32_t(j)));
+    runs[slot(grid[i].first)] = {grid[i].first, uint32_t(i), uint32_t(j)};
   }
 
   size_t attached = 0;
@@ -1397,7 +1428,6 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
   // vertices are not manifold, count again instead.
   bool recount = surf.pinched != 0 || diag.nonmanifold_edges != 0;
   bool loops_grew = false;
-  std::vector<uint32_t> near;
   // Each triangle near a sample is looked at once, though it is in the
   // stars of three vertices.
   std::vector<uint32_t> stamp;
@@ -1406,27 +1436,13 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     if (used[s])
       continue;
     const double *p = xyz + 3 * size_t(s);
-    near.clear();
     stamp.resize(tris.size() / 3, UINT32_MAX);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          auto run = runs.find(key(p, dx, dy, dz));
-          if (run == runs.end())
-            continue;
-          for (uint32_t i = run->second.first; i < run->second.second; ++i)
-            for_star(grid[i].second, [&](uint32_t t) {
-              if (stamp[t] != s) {
-                stamp[t] = s;
-                near.push_back(t);
-              }
-            });
-        }
     // The nearest triangle, if the sample is closer to it than its longest
-    // edge (farther samples are outliers and stay out).
+    // edge (farther samples are outliers and stay out), among those with a
+    // vertex in the grid cells around the sample; the first found of equals.
     double best = std::numeric_limits<double>::infinity(), bw[3] = {0, 0, 0};
     uint32_t bt = UINT32_MAX;
-    for (uint32_t t : near) {
+    auto consider = [&](uint32_t t) {
       const uint32_t *v = &tris[3 * size_t(t)];
       const double *a = xyz + 3 * size_t(v[0]), *b = xyz + 3 * size_t(v[1]),
                    *c = xyz + 3 * size_t(v[2]);
@@ -1441,7 +1457,7 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
         box2 += out * out;
       }
       if (box2 > best * (1 + 1e-9))
-        continue;
+        return;
       double w[3];
       closest_on_triangle(p, a, b, c, w);
       double q[3];
@@ -1452,6 +1468,31 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
       if (d < best && d <= longest) {
         best = d, bt = t;
         std::copy(w, w + 3, bw);
+      }
+    };
+    // The sample's own grid cell first, then the 26 around it: the best
+    // triangle of its own cell lets most vertices of the others be passed
+    // over. (The order decides only between triangles exactly as near,
+    // such as the fan around the vertex nearest to the sample.)
+    for (int o = 0; o < 27; ++o) {
+      const int j = o == 0 ? 13 : o <= 13 ? o - 1 : o;
+      const Run &run = runs[slot(key(p, j / 9 - 1, j / 3 % 3 - 1, j % 3 - 1))];
+      for (uint32_t i = run.first; i < run.last; ++i) {
+        const uint32_t u = grid[i].second;
+        // Vertices none of whose triangles can be taken (see reach), with
+        // a margin far above rounding: leaving out triangles that cannot
+        // win changes nothing.
+        const double du = std::sqrt(dist2(p, xyz + 3 * size_t(u))),
+                     lu = reach[u] * (1 + 1e-6);
+        if (du > 2 * lu || (du > lu && (du - lu) * (du - lu) >
+                                           best * (1 + 1e-6)))
+          continue;
+        for_star(u, [&](uint32_t t) {
+          if (stamp[t] != s) {
+            stamp[t] = s;
+            consider(t);
+          }
+        });
       }
     }
     if (bt == UINT32_MAX)
@@ -1470,12 +1511,14 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     auto set = [&](uint32_t t, uint32_t a, uint32_t b, uint32_t c) {
       tris[3 * size_t(t)] = a, tris[3 * size_t(t) + 1] = b,
                        tris[3 * size_t(t) + 2] = c;
+      reaches(t);
     };
     auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
       uint32_t t = uint32_t(tris.size() / 3);
       tris.push_back(a), tris.push_back(b), tris.push_back(c);
       gained[a].push_back(t), gained[b].push_back(t), gained[c].push_back(t);
       surf.component.push_back(surf.component[bt]);
+      reaches(t);
       return t;
     };
     // Three triangles for one, or four for two: one more vertex, three
