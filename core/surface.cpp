@@ -92,7 +92,8 @@ struct EdgeTable {
 
   // Without `angles`, the triangles of an edge come in the order of their
   // numbers and Entry::angle is 0: enough for finding edges and their
-  // triangles, and it saves an atan2 per corner.
+  // triangles, and it saves an atan2 per corner. (With them, an edge of a
+  // single triangle has angle 0 too: nothing compares it.)
   void build(const double *xyz, size_t n, const std::vector<uint32_t> &tris,
              Progress &progress, bool angles = true) {
     const size_t nt = tris.size() / 3;
@@ -110,20 +111,15 @@ struct EdgeTable {
     for (size_t t = 0; t < nt; ++t) {
       progress.tick(t, 2 * nt);
       for (int k = 0; k < 3; ++k) {
-        uint32_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3],
-                 c = tris[3 * t + (k + 2) % 3];
-        uint32_t lo = std::min(a, b), hi = std::max(a, b);
-        entries[fill[lo]++] = {edge_key(a, b),
-                               angles ? angle(xyz, lo, hi, c) : 0.0,
-                               uint32_t(t), uint8_t(k)};
+        uint32_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3];
+        entries[fill[std::min(a, b)]++] = {edge_key(a, b), 0.0, uint32_t(t),
+                                           uint8_t(k)};
       }
     }
     for (size_t v = 0; v < n; ++v)
       std::sort(entries.begin() + count[v], entries.begin() + count[v + 1],
                 [](const Entry &x, const Entry &y) {
-                  return x.key != y.key       ? x.key < y.key
-                         : x.angle != y.angle ? x.angle < y.angle
-                                              : x.tri < y.tri;
+                  return x.key != y.key ? x.key < y.key : x.tri < y.tri;
                 });
     first.clear();
     tri_edge.assign(3 * nt, 0);
@@ -135,6 +131,25 @@ struct EdgeTable {
           uint32_t(first.size() - 1);
     }
     first.push_back(uint32_t(entries.size()));
+    if (!angles)
+      return;
+    // Each edge's frame once, then its triangles by angle (ties by number).
+    for (size_t e = 0; e + 1 < first.size(); ++e) {
+      Entry *x = &entries[first[e]];
+      const uint32_t k = first[e + 1] - first[e];
+      if (k < 2)
+        continue;
+      const Frame f(xyz, key_lo(x->key), uint32_t(x->key));
+      for (uint32_t i = 0; i < k; ++i)
+        x[i].angle =
+            f.angle(xyz, tris[3 * size_t(x[i].tri) + (x[i].corner + 2) % 3]);
+      for (uint32_t i = 1; i < k; ++i)
+        for (uint32_t j = i; j > 0 && (x[j].angle < x[j - 1].angle ||
+                                       (x[j].angle == x[j - 1].angle &&
+                                        x[j].tri < x[j - 1].tri));
+             --j)
+          std::swap(x[j], x[j - 1]);
+    }
   }
 
   // Keeps only the entries of triangles with alive[t] set, renumbered in
@@ -165,32 +180,42 @@ struct EdgeTable {
     first.push_back(uint32_t(out));
   }
 
-  // Angle of the half-plane through edge lo-hi that contains point c.
-  static double angle(const double *xyz, uint32_t lo, uint32_t hi,
-                      uint32_t c) {
-    const double *a = xyz + 3 * size_t(lo), *b = xyz + 3 * size_t(hi),
-                 *p = xyz + 3 * size_t(c);
-    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    double lu = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-    u[0] /= lu, u[1] /= lu, u[2] /= lu;
-    // A reference direction perpendicular to u, from the coordinate axis
-    // least aligned with it; any fixed choice works as long as it is the
-    // same for every triangle on the edge.
-    int m = std::fabs(u[0]) <= std::fabs(u[1])
-                ? (std::fabs(u[0]) <= std::fabs(u[2]) ? 0 : 2)
-                : (std::fabs(u[1]) <= std::fabs(u[2]) ? 1 : 2);
-    double ax[3] = {0, 0, 0};
-    ax[m] = 1;
-    double e1[3] = {u[1] * ax[2] - u[2] * ax[1], u[2] * ax[0] - u[0] * ax[2],
-                    u[0] * ax[1] - u[1] * ax[0]};
-    double l1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
-    e1[0] /= l1, e1[1] /= l1, e1[2] /= l1;
-    double e2[3] = {u[1] * e1[2] - u[2] * e1[1], u[2] * e1[0] - u[0] * e1[2],
-                    u[0] * e1[1] - u[1] * e1[0]};
-    double w[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
-    return std::atan2(w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2],
-                      w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2]);
-  }
+  // Angles of the half-planes through edge lo-hi, about a frame of the
+  // edge: u along it, e1 and e2 across it.
+  struct Frame {
+    const double *a;
+    double e1[3], e2[3];
+    Frame(const double *xyz, uint32_t lo, uint32_t hi) {
+      a = xyz + 3 * size_t(lo);
+      const double *b = xyz + 3 * size_t(hi);
+      double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      double lu = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+      u[0] /= lu, u[1] /= lu, u[2] /= lu;
+      // A reference direction perpendicular to u, from the coordinate axis
+      // least aligned with it; any fixed choice works as long as it is the
+      // same for every triangle on the edge.
+      int m = std::fabs(u[0]) <= std::fabs(u[1])
+                  ? (std::fabs(u[0]) <= std::fabs(u[2]) ? 0 : 2)
+                  : (std::fabs(u[1]) <= std::fabs(u[2]) ? 1 : 2);
+      double ax[3] = {0, 0, 0};
+      ax[m] = 1;
+      e1[0] = u[1] * ax[2] - u[2] * ax[1];
+      e1[1] = u[2] * ax[0] - u[0] * ax[2];
+      e1[2] = u[0] * ax[1] - u[1] * ax[0];
+      double l1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+      e1[0] /= l1, e1[1] /= l1, e1[2] /= l1;
+      e2[0] = u[1] * e1[2] - u[2] * e1[1];
+      e2[1] = u[2] * e1[0] - u[0] * e1[2];
+      e2[2] = u[0] * e1[1] - u[1] * e1[0];
+    }
+    // The angle of the half-plane that contains point c.
+    double angle(const double *xyz, uint32_t c) const {
+      const double *p = xyz + 3 * size_t(c);
+      double w[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+      return std::atan2(w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2],
+                        w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2]);
+    }
+  };
 };
 
 thread_local Pool<EdgeTable::Entry> EdgeTable::entry_pool;
