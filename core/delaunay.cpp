@@ -563,19 +563,22 @@ private:
       for (int k = 0; k < 3; ++k)
         hull.emplace_back(c->vertex((inf + 1 + k) % 4), nrm);
     }
-    std::sort(hull.begin(), hull.end(),
-              [](const std::pair<Vh, V3> &x, const std::pair<Vh, V3> &y) {
-                return &*x.first < &*y.first;
-              });
-    for (size_t i = 0; i < hull.size();) {
-      size_t j = i;
-      while (j < hull.size() && hull[j].first == hull[i].first)
-        ++j;
-      for (size_t a = i; a < j; ++a)
-        for (size_t b = a + 1; b < j; ++b)
+    // The normals about each hull vertex, as a list per vertex (sorting
+    // them by vertex cost more than the rest of this stage on small input).
+    std::vector<uint32_t> head(dt_.number_of_vertices(), UINT32_MAX),
+        next(hull.size());
+    for (uint32_t i = 0; i < hull.size(); ++i) {
+      const uint32_t v = hull[i].first->info().idx;
+      next[i] = head[v];
+      head[v] = i;
+    }
+    for (uint32_t i = 0; i < hull.size(); ++i) {
+      if (head[hull[i].first->info().idx] != i)
+        continue;
+      for (uint32_t a = i; a != UINT32_MAX; a = next[a])
+        for (uint32_t b = next[a]; b != UINT32_MAX; b = next[b])
           if (dot(hull[a].second, hull[b].second) < cos_fan)
             hull[i].first->info().r2 = kInf;
-      i = j;
     }
     hull = {};
 
