@@ -430,14 +430,28 @@ bool is_triangle_of(const EdgeTable &et, const std::vector<uint32_t> &tris,
 // Patches the loop (vertex numbers in order; the hole runs along it) with
 // the triangulation of least total area whose chords are all new edges, and
 // appends its triangles to res and its chords to `chords`. The edge from the
-// last vertex back to the first is part of the loop. Returns false when no
-// such triangulation exists.
-template <class HasEdge>
+// last vertex back to the first is part of the loop. for_neighbours(v, f)
+// calls f on every vertex joined to v by an edge; pos is scratch, n entries
+// of UINT32_MAX, left so. Returns false when no such triangulation exists.
+template <class ForNeighbours>
 bool patch(const double *xyz, const std::vector<uint32_t> &loop,
-           HasEdge has_edge, std::vector<double> &cost,
+           ForNeighbours for_neighbours, std::vector<uint32_t> &pos,
+           std::vector<uint8_t> &joined, std::vector<double> &cost,
            std::vector<double> &costT, std::vector<uint32_t> &split,
            std::vector<uint32_t> &res, std::vector<uint64_t> &chords) {
   const size_t L = loop.size();
+  // Which of the loop's vertices are joined already, from their neighbours
+  // (the programme below asks about every pair).
+  for (size_t i = 0; i < L; ++i)
+    pos[loop[i]] = uint32_t(i);
+  joined.assign(L * L, 0);
+  for (size_t i = 0; i < L; ++i)
+    for_neighbours(loop[i], [&](uint32_t w) {
+      if (pos[w] != UINT32_MAX)
+        joined[i * L + pos[w]] = 1;
+    });
+  for (size_t i = 0; i < L; ++i)
+    pos[loop[i]] = UINT32_MAX;
   // The loop's points side by side: the triple loop below reads them
   // L^3 / 6 times.
   std::vector<double> p(3 * L);
@@ -464,7 +478,7 @@ bool patch(const double *xyz, const std::vector<uint32_t> &loop,
     for (size_t i = 0; i + len < L; ++i) {
       size_t j = i + len;
       // (0, L-1) is a loop edge; any other chord must be a new edge.
-      if (!(i == 0 && j == L - 1) && has_edge(loop[i], loop[j]))
+      if (!(i == 0 && j == L - 1) && joined[i * L + j])
         continue;
       const double *left = &cost[i * L], *right = &costT[j * L];
       double best = inf;
@@ -622,6 +636,12 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
         return true;
     return false;
   };
+  auto for_neighbours = [&](uint32_t a, auto &&visit) {
+    for (uint32_t i = adj_first[a]; i < adj_first[a + 1]; ++i)
+      visit(adj[i]);
+    for (uint32_t i = chord_head[a]; i != UINT32_MAX; i = links[i].next)
+      visit(links[i].other);
+  };
   // The hole runs against the orientation of the triangle on each boundary
   // edge: a triangle with x -> y leaves the hole edge y -> x.
   std::vector<uint32_t> next(n, UINT32_MAX);
@@ -643,8 +663,8 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
   std::vector<uint32_t> loop;
   std::vector<std::vector<uint32_t>> loops, pieces;
   std::vector<double> cost, costT;
-  std::vector<uint32_t> split;
-  std::vector<uint8_t> seen(n, 0);
+  std::vector<uint32_t> split, pos(n, UINT32_MAX);
+  std::vector<uint8_t> joined, seen(n, 0);
   for (uint32_t v0 = 0; v0 < n; ++v0) {
     if (next[v0] == UINT32_MAX || seen[v0])
       continue;
@@ -716,8 +736,8 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     std::vector<uint64_t> added_chords;
     bool ok_all = cut_ok && work <= max_work;
     for (size_t p = 0; p < pieces.size() && ok_all; ++p)
-      ok_all = patch(xyz, pieces[p], has_edge, cost, costT, split, res,
-                     added_chords);
+      ok_all = patch(xyz, pieces[p], for_neighbours, pos, joined, cost, costT,
+                     split, res, added_chords);
     if (ok_all) {
       max_work -= work;
       for (uint64_t k : added_chords)
