@@ -219,7 +219,6 @@ bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles,
   double n2 = norm2(n);
   if (!(n2 > 0))
     return false;
-  n = (1 / std::sqrt(n2)) * n;
 
   if (cr.mode == SC_MODE_COCONE) {
     if (!interior[0] && !interior[1] && !interior[2])
@@ -238,6 +237,7 @@ bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles,
     }
     return true;
   }
+  n = (1 / std::sqrt(n2)) * n;
 
   // Criterion 1: the normal at the vertex with the largest angle, which is
   // the vertex opposite the longest edge.
