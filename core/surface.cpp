@@ -1450,8 +1450,11 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     uint64_t key;
     uint32_t first, last; // last == 0: an empty slot
   };
+  size_t occupied = 0;
+  for (size_t i = 0; i < grid.size(); ++i)
+    occupied += i == 0 || grid[i].first != grid[i - 1].first;
   size_t slots = 16;
-  while (slots < 2 * grid.size())
+  while (slots < 2 * occupied)
     slots *= 2;
   std::vector<Run> runs(slots, Run{0, 0, 0});
   const size_t mask = slots - 1;
