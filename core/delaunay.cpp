@@ -357,12 +357,17 @@ private:
   // (ties by input index) and fills to_input (vertex number -> input index).
   void number_vertices(const double *xyz, size_t n,
                        std::vector<uint32_t> &to_input) {
-    to_input.clear();
-    to_input.reserve(dt_.number_of_vertices());
+    // The vertices' indices in increasing order (the sort below starts
+    // from an order that depends only on the points), without sorting.
+    std::vector<uint8_t> is_vertex(n, 0);
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v)
-      to_input.push_back(v->info().idx);
-    std::sort(to_input.begin(), to_input.end());
+      is_vertex[v->info().idx] = 1;
+    to_input.clear();
+    to_input.reserve(dt_.number_of_vertices());
+    for (size_t i = 0; i < n; ++i)
+      if (is_vertex[i])
+        to_input.push_back(uint32_t(i));
     CGAL::hilbert_sort(to_input.begin(), to_input.end(),
                        CGAL::Spatial_sort_traits_adapter_3<K, XyzMap>(
                            XyzMap{xyz}));
