@@ -63,7 +63,7 @@ thread_local Pool<uint32_t> u32_pool;
 struct EdgeTable {
   struct Entry {
     uint64_t key;
-    double angle;
+    double angle; // about the edge, from a reference direction (build())
     uint32_t tri;
     uint8_t corner; // the edge is (v[corner], v[corner + 1]) of tri
     // Left uninitialised: build() writes every entry of a table sized up
@@ -93,7 +93,8 @@ struct EdgeTable {
   // Without `angles`, the triangles of an edge come in the order of their
   // numbers and Entry::angle is 0: enough for finding edges and their
   // triangles, and it saves an atan2 per corner. (With them, an edge of a
-  // single triangle has angle 0 too: nothing compares it.)
+  // single triangle has angle 0 too, for nothing compares it, and an edge
+  // of two has angles 0 and 0 or pi: see below.)
   void build(const double *xyz, size_t n, const std::vector<uint32_t> &tris,
              Progress &progress, bool angles = true) {
     const size_t nt = tris.size() / 3;
@@ -139,10 +140,30 @@ struct EdgeTable {
       const uint32_t k = first[e + 1] - first[e];
       if (k < 2)
         continue;
+      if (k == 2) {
+        // Two triangles are in either order about their edge, and all
+        // that is asked of their angles is whether they are less than a
+        // right angle apart (is_sharp()): angles 0 and 0 if they are, 0
+        // and pi if not. The sign of the dot product of the two
+        // triangles' directions across the edge tells, without an atan2.
+        const double *a = xyz + 3 * size_t(key_lo(x->key)),
+                     *b = xyz + 3 * size_t(uint32_t(x->key));
+        const double *p = xyz + 3 * size_t(third(tris, x[0])),
+                     *q = xyz + 3 * size_t(third(tris, x[1]));
+        double u[3], w1[3], w2[3];
+        for (int j = 0; j < 3; ++j)
+          u[j] = b[j] - a[j], w1[j] = p[j] - a[j], w2[j] = q[j] - a[j];
+        auto dot = [](const double *s, const double *t) {
+          return s[0] * t[0] + s[1] * t[1] + s[2] * t[2];
+        };
+        const double across =
+            dot(w1, w2) * dot(u, u) - dot(w1, u) * dot(w2, u);
+        x[0].angle = 0;
+        x[1].angle = across > 0 ? 0.0 : M_PI;
+      }
       const Frame f(xyz, key_lo(x->key), uint32_t(x->key));
       for (uint32_t i = 0; i < k; ++i)
-        x[i].angle =
-            f.angle(xyz, tris[3 * size_t(x[i].tri) + (x[i].corner + 2) % 3]);
+        x[i].angle = f.angle(xyz, third(tris, x[i]));
       for (uint32_t i = 1; i < k; ++i)
         for (uint32_t j = i; j > 0 && (x[j].angle < x[j - 1].angle ||
                                        (x[j].angle == x[j - 1].angle &&
@@ -178,6 +199,11 @@ struct EdgeTable {
     entries.resize(out);
     first.resize(edges);
     first.push_back(uint32_t(out));
+  }
+
+  // The vertex of entry x's triangle that is not on its edge.
+  static uint32_t third(const std::vector<uint32_t> &tris, const Entry &x) {
+    return tris[3 * size_t(x.tri) + (x.corner + 2) % 3];
   }
 
   // Angles of the half-planes through edge lo-hi, about a frame of the
