@@ -388,6 +388,52 @@ int count_fans(uint32_t v, const std::vector<uint32_t> &star,
   return fans;
 }
 
+// Whether the triangles around vertex v are one fan, shown by a chain
+// through all of them, each sharing with the next its edge at v that the
+// orientation puts last in the one and first in the next (from a triangle
+// that no other one precedes, if there is one). It nearly always is; when
+// no such chain is found, count_fans() decides.
+bool one_fan(uint32_t v, const std::vector<uint32_t> &star,
+             const std::vector<uint32_t> &tris) {
+  constexpr size_t kMax = 32;
+  const size_t m = star.size();
+  if (m <= 1)
+    return true;
+  if (m > kMax)
+    return false;
+  uint32_t a[kMax], b[kMax]; // triangle i runs v -> a[i] -> b[i]
+  for (size_t i = 0; i < m; ++i) {
+    const uint32_t *t = &tris[3 * size_t(star[i])];
+    const int k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+    a[i] = t[(k + 1) % 3];
+    b[i] = t[(k + 2) % 3];
+  }
+  size_t i = 0;
+  for (size_t s = 0; s < m; ++s) {
+    bool preceded = false;
+    for (size_t j = 0; j < m && !preceded; ++j)
+      preceded = b[j] == a[s];
+    if (!preceded) {
+      i = s;
+      break;
+    }
+  }
+  uint32_t done = 1u << i;
+  size_t chained = 1;
+  for (;;) {
+    size_t next = m;
+    for (size_t j = 0; j < m && next == m; ++j)
+      if (!(done >> j & 1) && a[j] == b[i])
+        next = j;
+    if (next == m)
+      break;
+    done |= 1u << next;
+    ++chained;
+    i = next;
+  }
+  return chained == m;
+}
+
 } // namespace
 
 void fix_fans(size_t n, const std::vector<uint32_t> &otri,
@@ -407,6 +453,8 @@ void fix_fans(size_t n, const std::vector<uint32_t> &otri,
     for (uint32_t i = ostar.first[v]; i < ostar.first[v + 1]; ++i)
       if (in[ostar.tris[i]])
         cur.push_back(ostar.tris[i]);
+    if (one_fan(v, cur, otri))
+      continue;
     int fans = count_fans(v, cur, otri, fan_of);
     if (fans <= 1)
       continue;
