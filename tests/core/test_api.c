@@ -206,6 +206,21 @@ int main(void) {
     CHECK_EQ_INT(pr.last_stage, s);
   }
 
+  /* The allocator hint is taken by glibc's own malloc (the sanitizers
+   * bring theirs) and changes nothing in the result. */
+  int tuned = sc_tune_allocator();
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) &&                    \
+    !defined(__SANITIZE_THREAD__)
+  CHECK_EQ_INT(tuned, SC_OK);
+#else
+  CHECK(tuned == SC_OK || tuned == SC_EINTERNAL);
+#endif
+  sc_params_init(&p);
+  sc_mesh_t *tuned_mesh = NULL;
+  CHECK_EQ_INT(sc_reconstruct(xyz, N, &p, &tuned_mesh, msg, sizeof msg), 0);
+  CHECK(tuned_mesh && same_surface(ref, tuned_mesh));
+  sc_mesh_free(tuned_mesh);
+
   sc_mesh_free(ref);
   free(xyz);
   return CHECK_DONE();
