@@ -272,8 +272,9 @@ uint64_t sc_estimate_bytes(uint64_t n);
  * glibc's defaults each such buffer is a fresh mapping whose pages are
  * faulted in one by one (a sixth of the time on 362k points). Process-wide
  * (glibc's mallopt(): no mmap for large blocks, no trimming on free), so it
- * is for programs to call, once, before their first reconstruction; a
- * long-running one gives the memory back with malloc_trim() when idle.
+ * is for programs to call, once, before their first reconstruction. (A
+ * program that reconstructs on several threads and must shrink when idle
+ * should not: malloc_trim() does not shrink the heaps of threads' arenas.)
  * Returns 0, or SC_EINTERNAL when the allocator is not glibc's or refused.
  */
 int sc_tune_allocator(void);
