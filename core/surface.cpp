@@ -22,6 +22,10 @@ constexpr size_t kMinOpenLoop = 8;
 // least-area patch costs the cube of the length.
 constexpr size_t kMaxPatch = 32;
 
+double dot3(const double *x, const double *y) {
+  return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+}
+
 inline uint64_t edge_key(uint32_t a, uint32_t b) {
   return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
 }
@@ -153,11 +157,8 @@ struct EdgeTable {
         double u[3], w1[3], w2[3];
         for (int j = 0; j < 3; ++j)
           u[j] = b[j] - a[j], w1[j] = p[j] - a[j], w2[j] = q[j] - a[j];
-        auto dot = [](const double *s, const double *t) {
-          return s[0] * t[0] + s[1] * t[1] + s[2] * t[2];
-        };
         const double across =
-            dot(w1, w2) * dot(u, u) - dot(w1, u) * dot(w2, u);
+            dot3(w1, w2) * dot3(u, u) - dot3(w1, u) * dot3(w2, u);
         x[0].angle = 0;
         x[1].angle = across > 0 ? 0.0 : M_PI;
       }
@@ -701,20 +702,16 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
       chord_head[links[i].other] = links[i + 1].next;
     }
   };
-  auto has_edge = [&](uint32_t a, uint32_t b) {
-    for (uint32_t i = adj_first[a]; i < adj_first[a + 1]; ++i)
-      if (adj[i] == b)
-        return true;
-    for (uint32_t i = chord_head[a]; i != UINT32_MAX; i = links[i].next)
-      if (links[i].other == b)
-        return true;
-    return false;
-  };
   auto for_neighbours = [&](uint32_t a, auto &&visit) {
     for (uint32_t i = adj_first[a]; i < adj_first[a + 1]; ++i)
       visit(adj[i]);
     for (uint32_t i = chord_head[a]; i != UINT32_MAX; i = links[i].next)
       visit(links[i].other);
+  };
+  auto has_edge = [&](uint32_t a, uint32_t b) {
+    bool joined = false;
+    for_neighbours(a, [&](uint32_t w) { joined = joined || w == b; });
+    return joined;
   };
   // The hole runs against the orientation of the triangle on each boundary
   // edge: a triangle with x -> y leaves the hole edge y -> x.
@@ -1352,10 +1349,7 @@ void closest_on_triangle(const double *p, const double *a, const double *b,
   double ab[3], ac[3], ap[3];
   for (int k = 0; k < 3; ++k)
     ab[k] = b[k] - a[k], ac[k] = c[k] - a[k], ap[k] = p[k] - a[k];
-  auto dot = [](const double *x, const double *y) {
-    return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-  };
-  double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
   if (d1 <= 0 && d2 <= 0) {
     w[0] = 1, w[1] = 0, w[2] = 0;
     return;
@@ -1363,7 +1357,7 @@ void closest_on_triangle(const double *p, const double *a, const double *b,
   double bp[3], cp[3];
   for (int k = 0; k < 3; ++k)
     bp[k] = p[k] - b[k], cp[k] = p[k] - c[k];
-  double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
   if (d3 >= 0 && d4 <= d3) {
     w[0] = 0, w[1] = 1, w[2] = 0;
     return;
@@ -1374,7 +1368,7 @@ void closest_on_triangle(const double *p, const double *a, const double *b,
     w[0] = 1 - v, w[1] = v, w[2] = 0;
     return;
   }
-  double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
   if (d6 >= 0 && d5 <= d6) {
     w[0] = 0, w[1] = 0, w[2] = 1;
     return;
@@ -1484,23 +1478,23 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
   // has no triangle the sample may join, and one farther than its reach
   // plus the distance to the best triangle so far has no nearer one.
   std::vector<double> reach(n, 0.0);
+  // Also returns the sum of triangle t's edge lengths.
   auto reaches = [&](uint32_t t) {
     const uint32_t *v = &tris[3 * size_t(t)];
-    double l = 0;
-    for (int k = 0; k < 3; ++k)
-      l = std::max(l, dist2(xyz + 3 * size_t(v[k]),
-                            xyz + 3 * size_t(v[(k + 1) % 3])));
-    l = std::sqrt(l);
+    double l = 0, sum = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double e = std::sqrt(dist2(xyz + 3 * size_t(v[k]),
+                                       xyz + 3 * size_t(v[(k + 1) % 3])));
+      sum += e;
+      l = std::max(l, e);
+    }
     for (int k = 0; k < 3; ++k)
       reach[v[k]] = std::max(reach[v[k]], l);
+    return sum;
   };
   double edge_sum = 0;
-  for (size_t t = 0; t < nt; ++t) {
-    for (int k = 0; k < 3; ++k)
-      edge_sum += std::sqrt(dist2(xyz + 3 * size_t(tris[3 * t + k]),
-                                  xyz + 3 * size_t(tris[3 * t + (k + 1) % 3])));
-    reaches(uint32_t(t));
-  }
+  for (size_t t = 0; t < nt; ++t)
+    edge_sum += reaches(uint32_t(t));
   const double cell = 2 * edge_sum / double(3 * nt);
   if (!(cell > 0))
     return 0;
