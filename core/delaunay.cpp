@@ -737,15 +737,19 @@ private:
       if (state[q->info().idx] == 1)
         q->info().flags |= kVInterior;
 
-    // Auto mode: when most samples are not interior the sample is too
-    // sparse or too small to tell a boundary from undersampling (every
-    // sample of a tetrahedron is a boundary sample), and boundary mode
-    // would keep nothing; run the closed-surface algorithm instead.
+    // Auto and watertight mode: when most samples are not interior the
+    // sample is too sparse or too small to tell a boundary from
+    // undersampling (every sample of a tetrahedron is a boundary sample,
+    // and two thirds of a sparse genus-2 surface's), and boundary mode
+    // would keep little, or would open true handles that watertight mode
+    // then cuts; run the closed-surface algorithm instead (watertight mode
+    // still closes what it leaves open).
     size_t interior = 0;
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v)
       interior += (v->info().flags & kVInterior) != 0;
-    if (params.mode == SC_MODE_AUTO && 2 * interior < m) {
+    if ((params.mode == SC_MODE_AUTO || params.mode == SC_MODE_WATERTIGHT) &&
+        2 * interior < m) {
       for (auto v = dt_.finite_vertices_begin();
            v != dt_.finite_vertices_end(); ++v)
         v->info().flags |= kVInterior;

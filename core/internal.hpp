@@ -74,7 +74,8 @@ struct Filtered {
   std::vector<uint32_t> to_input; // vertex number -> input index
   std::vector<std::pair<uint32_t, uint32_t>> dups; // (duplicate, first), input
   // Per vertex: 0 for an interior sample, kBoundarySample or kOpenSample
-  // for the others; empty when boundary detection did not run.
+  // for the others; empty when boundary detection did not run, or found
+  // too few interior samples to tell (the sample is then taken as closed).
   std::vector<uint8_t> boundary;
 };
 
@@ -247,8 +248,10 @@ public:
 
 private:
   void insert_range(size_t first, size_t n);
-  void close_surface(const double *lxyz, size_t m, Progress &progress,
-                     Surface &surf, sc_diag_t &diag);
+  // Watertight mode: closes surf; first cuts the handles that closed round
+  // holes of the scan when `cut`.
+  void close_surface(const double *lxyz, size_t m, bool cut,
+                     Progress &progress, Surface &surf, sc_diag_t &diag);
   sc_params_t params_;
   std::vector<double> own_;
   const double *xyz_ = nullptr;

@@ -98,8 +98,8 @@ struct Closure {
 // fraction of the time. Closed components take no part in the labelling
 // (two nested spheres would otherwise vote against each other) and are
 // added back as they are.
-void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
-                          Surface &surf, sc_diag_t &diag) {
+void Recon::close_surface(const double *lxyz, size_t m, bool cut,
+                          Progress &progress, Surface &surf, sc_diag_t &diag) {
   const uint64_t loops = diag.boundary_loops, before = diag.triangles;
   std::vector<uint32_t> open, closed_part;
   for (size_t t = 0; t < surf.tris.size() / 3; ++t)
@@ -124,7 +124,7 @@ void Recon::close_surface(const double *lxyz, size_t m, Progress &progress,
   sc_diag_t db = diag;
   // Handles that closed round a hole, where the scan has no samples, would
   // stay in any closure: cut them first (see cut_handles()).
-  const uint64_t handles = cut_handles(lxyz, m, open, progress);
+  const uint64_t handles = cut ? cut_handles(lxyz, m, open, progress) : 0;
   if (handles) {
     surf.tris = open;
     surf.tris.insert(surf.tris.end(), closed_part.begin(), closed_part.end());
@@ -296,10 +296,15 @@ sc_mesh_t *Recon::finish() {
 
   progress.stage(SC_STAGE_EXTRACT);
   Surface surf;
-  // Watertight mode closes every hole by labelling cells, so nothing is
-  // filled before that.
+  // Watertight mode cuts the handles that closed round holes of the scan
+  // and then closes every hole, so nothing is filled before that. Where
+  // the sample was found to look closed (no boundary detection: see
+  // classify()), a hole is a few missing triangles, not a part of the
+  // surface the scan missed: the small ones are filled as in the other
+  // modes, and no handle is cut.
+  const bool scan_holes = watertight && !f.boundary.empty();
   extract(lxyz.data(), m, f.tris, alive, std::move(table),
-          watertight ? 0 : size_t(params_.max_hole_edges), f.boundary,
+          scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary,
           progress, surf, diag);
   if (detects_boundary(params_.mode)) {
     // Real scans: overlapping layers leave bubbles, small closed components
@@ -314,7 +319,7 @@ sc_mesh_t *Recon::finish() {
     diag.bubbles_dropped =
         closed_before - std::min(closed_before, diag.closed_components);
     if (watertight)
-      close_surface(lxyz.data(), m, progress, surf, diag);
+      close_surface(lxyz.data(), m, scan_holes, progress, surf, diag);
     diag.samples_attached =
         attach_samples(lxyz.data(), m, surf, progress, diag);
   }
