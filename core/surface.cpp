@@ -161,6 +161,7 @@ struct EdgeTable {
             dot3(w1, w2) * dot3(u, u) - dot3(w1, u) * dot3(w2, u);
         x[0].angle = 0;
         x[1].angle = across > 0 ? 0.0 : M_PI;
+        continue;
       }
       const Frame f(xyz, key_lo(x->key), uint32_t(x->key));
       for (uint32_t i = 0; i < k; ++i)
