@@ -179,7 +179,7 @@ struct Criteria {
   int mode;
   double cos_theta1; // criterion 1: |cos(n_t, p_s)| >= this
   double tan_phi;    // criterion 2: dual edge meets [-R tan phi, R tan phi]
-  double sin_cocone; // cocone: |cos(y - s, p_s)| <= this
+  double sin2_cocone; // cocone: cos^2(y - s, p_s) <= this
 
   explicit Criteria(const sc_params_t &p)
       : mode(p.mode == SC_MODE_SHORTCRUST ? SC_MODE_SHORTCRUST
@@ -192,21 +192,23 @@ struct Criteria {
     cos_theta1 = theta1 >= M_PI / 2 ? 0.0 : std::cos(theta1);
     tan_phi = phi >= M_PI / 2 ? std::numeric_limits<double>::infinity()
                               : std::tan(phi);
-    sin_cocone = std::sin(p.cocone_theta);
+    sin2_cocone = std::sin(p.cocone_theta) * std::sin(p.cocone_theta);
   }
 };
 
 // Where a point of the dual Voronoi edge lies relative to the cocone of a
 // sample: -1 or +1 in one of the two cones around the pole, 0 inside the
 // cocone.
-inline int cone_side(V3 dir, V3 pole_unit, double sin_cocone) {
-  double len = std::sqrt(norm2(dir));
-  if (!(len > 0))
+// (Compared squared: no square root or division in this test, which runs
+// six times a facet.)
+inline int cone_side(V3 dir, V3 pole_unit, double sin2_cocone) {
+  const double len2 = norm2(dir);
+  if (!(len2 > 0))
     return 0;
-  double c = dot(dir, pole_unit) / len;
-  if (std::fabs(c) <= sin_cocone)
+  const double d = dot(dir, pole_unit);
+  if (d * d <= sin2_cocone * len2)
     return 0;
-  return c > 0 ? 1 : -1;
+  return d > 0 ? 1 : -1;
 }
 
 // The candidate test for triangle abc with indices idx. The dual Voronoi
@@ -227,10 +229,10 @@ bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles,
       if (!interior[k])
         continue;
       const V3 &pole = poles[k];
-      int s1 = cone_side(v1 - P[k], pole, cr.sin_cocone);
+      int s1 = cone_side(v1 - P[k], pole, cr.sin2_cocone);
       if (s1 == 0)
         continue;
-      int s2 = cone_side(ray ? v2 : v2 - P[k], pole, cr.sin_cocone);
+      int s2 = cone_side(ray ? v2 : v2 - P[k], pole, cr.sin2_cocone);
       if (s2 == 0 || s2 != s1)
         continue;
       return false;
@@ -545,7 +547,8 @@ private:
         params.boundary_rho > 0 ? params.boundary_rho : kDefaultRho;
     const double alpha =
         params.boundary_alpha > 0 ? params.boundary_alpha : kDefaultAlpha;
-    const double sin_c = std::sin(params.cocone_theta);
+    const double sin2_c =
+        std::sin(params.cocone_theta) * std::sin(params.cocone_theta);
     const double cos_a = std::cos(alpha);
     const float kInf = std::numeric_limits<float>::infinity();
 
@@ -624,11 +627,11 @@ private:
         double len2 = norm2(dv), dp = dot(dv, pole[j]);
         if (dp < 0 && float(len2) > d.h2)
           d.h2 = float(len2);
-        const double reach = sin_c * std::sqrt(len2);
-        in_cone[j] = std::fabs(dp) <= reach;
+        const double reach2 = sin2_c * len2;
+        in_cone[j] = dp * dp <= reach2;
         // The growth below counts the cell as in the cocone unless it is
         // clearly outside.
-        grow_cone[j] = !(std::fabs(dp) > reach);
+        grow_cone[j] = !(dp * dp > reach2);
         if (in_cone[j] && trusted && float(len2) > d.r2)
           d.r2 = float(len2);
       }
