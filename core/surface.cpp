@@ -436,12 +436,10 @@ bool one_fan(uint32_t v, const std::vector<uint32_t> &star,
   return chained == m;
 }
 
-} // namespace
-
-void fix_fans(size_t n, const std::vector<uint32_t> &otri,
-              std::vector<uint8_t> &in) {
-  VertexStar ostar;
-  ostar.build(n, otri, [&](size_t t) { return in[t] != 0; });
+// fix_fans() over the stars ostar of the triangles (those with in[t]
+// clear are passed over, so a star of more triangles will do).
+void fix_fans_in(size_t n, const VertexStar &ostar,
+                 const std::vector<uint32_t> &otri, std::vector<uint8_t> &in) {
   std::vector<uint32_t> work;
   for (uint32_t v = 0; v < n; ++v)
     if (ostar.first[v + 1] > ostar.first[v])
@@ -473,6 +471,15 @@ void fix_fans(size_t n, const std::vector<uint32_t> &otri,
           work.push_back(otri[3 * size_t(cur[i]) + k]);
     }
   }
+}
+
+} // namespace
+
+void fix_fans(size_t n, const std::vector<uint32_t> &otri,
+              std::vector<uint8_t> &in) {
+  VertexStar ostar;
+  ostar.build(n, otri, [&](size_t t) { return in[t] != 0; });
+  fix_fans_in(n, ostar, otri, in);
 }
 
 namespace {
@@ -973,6 +980,11 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     return true;
   };
 
+  // The triangles of the edge table alone, side by side: the walk reads
+  // little else of an entry, at every edge it crosses.
+  std::vector<uint32_t> etri(et.entries.size());
+  for (size_t i = 0; i < etri.size(); ++i)
+    etri[i] = et.entries[i].tri;
   size_t added = 0;
   std::vector<uint32_t> members, queue;
   auto walk = [&](uint32_t seed, uint32_t a, uint32_t b, uint32_t c,
@@ -994,12 +1006,12 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
         if (cnt < 2)
           continue;
         uint32_t pos = 0;
-        while (et.entries[lo + pos].tri != t)
+        while (etri[lo + pos] != t)
           ++pos;
         // Rotating toward the outer side of t is increasing angle when t
         // runs along the edge's reference direction, decreasing otherwise.
         uint32_t step = x < y ? 1 : cnt - 1;
-        uint32_t nb = et.entries[lo + (pos + step) % cnt].tri;
+        uint32_t nb = etri[lo + (pos + step) % cnt];
         if (in[nb])
           continue;
         const uint32_t *w = &live[3 * size_t(nb)];
@@ -1080,7 +1092,8 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     ++comps;
   }
 
-  fix_fans(n, otri, in);
+  // The stars of every live triangle, those the walk left out passed over.
+  fix_fans_in(n, star, otri, in);
 
   // The output, its components (triangles sharing an edge), and their
   // topology. Closed components facing inward are flipped.
