@@ -65,10 +65,10 @@ typedef enum sc_mode {
    * hole are cut, each boundary loop gets a least-area patch, and where
    * the patches cannot close the surface the Delaunay cells are labelled
    * inside or outside across it and the boundary of the inside cells is
-   * taken. The output is a closed 2-manifold. A sample in which most
-   * samples are found not interior (too sparse to tell a boundary from
-   * undersampling) is taken as closed, as in auto mode: the cocone test
-   * everywhere, and no handle cut. */
+   * taken. The output is a closed 2-manifold. When most samples are
+   * found not interior (too sparse to tell a boundary from
+   * undersampling), the input is taken as closed, as in auto mode: the
+   * cocone test everywhere, and no handle cut. */
   SC_MODE_WATERTIGHT = 3,
   /* For input not known to be closed: the cocone test where the samples
    * look like a closed surface, boundary mode where they do not (diag.path
