@@ -547,8 +547,7 @@ private:
         params.boundary_rho > 0 ? params.boundary_rho : kDefaultRho;
     const double alpha =
         params.boundary_alpha > 0 ? params.boundary_alpha : kDefaultAlpha;
-    const double sin2_c =
-        std::sin(params.cocone_theta) * std::sin(params.cocone_theta);
+    const double sin2_c = Criteria(params).sin2_cocone;
     const double cos_a = std::cos(alpha);
     const float kInf = std::numeric_limits<float>::infinity();
 

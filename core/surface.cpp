@@ -217,7 +217,7 @@ struct EdgeTable {
       a = xyz + 3 * size_t(lo);
       const double *b = xyz + 3 * size_t(hi);
       double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-      double lu = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+      double lu = std::sqrt(dot3(u, u));
       u[0] /= lu, u[1] /= lu, u[2] /= lu;
       // A reference direction perpendicular to u, from the coordinate axis
       // least aligned with it; any fixed choice works as long as it is the
@@ -230,7 +230,7 @@ struct EdgeTable {
       e1[0] = u[1] * ax[2] - u[2] * ax[1];
       e1[1] = u[2] * ax[0] - u[0] * ax[2];
       e1[2] = u[0] * ax[1] - u[1] * ax[0];
-      double l1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+      double l1 = std::sqrt(dot3(e1, e1));
       e1[0] /= l1, e1[1] /= l1, e1[2] /= l1;
       e2[0] = u[1] * e1[2] - u[2] * e1[1];
       e2[1] = u[2] * e1[0] - u[0] * e1[2];
@@ -240,8 +240,7 @@ struct EdgeTable {
     double angle(const double *xyz, uint32_t c) const {
       const double *p = xyz + 3 * size_t(c);
       double w[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
-      return std::atan2(w[0] * e2[0] + w[1] * e2[1] + w[2] * e2[2],
-                        w[0] * e1[0] + w[1] * e1[1] + w[2] * e1[2]);
+      return std::atan2(dot3(w, e2), dot3(w, e1));
     }
   };
 };
