@@ -560,34 +560,42 @@ private:
     // is infinite when two of them are more than (pi/2 - theta) / 2 apart:
     // the cell then opens up sideways, whatever the true normal is.
     const double cos_fan = std::cos((M_PI / 2 - params.cocone_theta) / 2);
-    std::vector<std::pair<Vh, V3>> hull;
+    // One normal per hull facet, and per hull vertex the list of the
+    // facet corners at it (sorting corners by vertex cost more than the
+    // rest of this stage on small input, and a vector of (vertex, normal)
+    // pairs grown one by one was most of its memory).
     std::vector<Ch> outside;
     dt_.incident_cells(dt_.infinite_vertex(), std::back_inserter(outside));
-    for (Ch c : outside) {
-      int inf = c->index(dt_.infinite_vertex());
-      V3 pts[3];
-      V3 nrm = hull_normal(c, inf, pts);
-      for (int k = 0; k < 3; ++k)
-        hull.emplace_back(c->vertex((inf + 1 + k) % 4), nrm);
-    }
-    // The normals about each hull vertex, as a list per vertex (sorting
-    // them by vertex cost more than the rest of this stage on small input).
+    std::vector<V3> hull(outside.size());
     std::vector<uint32_t> head(dt_.number_of_vertices(), UINT32_MAX),
-        next(hull.size());
-    for (uint32_t i = 0; i < hull.size(); ++i) {
-      const uint32_t v = hull[i].first->info().idx;
-      next[i] = head[v];
-      head[v] = i;
+        next(3 * outside.size());
+    auto corner = [&](uint32_t i) {
+      Ch c = outside[i / 3];
+      return c->vertex((c->index(dt_.infinite_vertex()) + 1 + i % 3) % 4);
+    };
+    for (uint32_t f = 0; f < outside.size(); ++f) {
+      V3 pts[3];
+      hull[f] = hull_normal(outside[f],
+                            outside[f]->index(dt_.infinite_vertex()), pts);
+      for (uint32_t i = 3 * f; i < 3 * f + 3; ++i) {
+        const uint32_t v = corner(i)->info().idx;
+        next[i] = head[v];
+        head[v] = i;
+      }
     }
-    for (uint32_t i = 0; i < hull.size(); ++i) {
-      if (head[hull[i].first->info().idx] != i)
+    for (uint32_t i = 0; i < next.size(); ++i) {
+      Vh v = corner(i);
+      if (head[v->info().idx] != i)
         continue;
       for (uint32_t a = i; a != UINT32_MAX; a = next[a])
         for (uint32_t b = next[a]; b != UINT32_MAX; b = next[b])
-          if (dot(hull[a].second, hull[b].second) < cos_fan)
-            hull[i].first->info().r2 = kInf;
+          if (dot(hull[a / 3], hull[b / 3]) < cos_fan)
+            v->info().r2 = kInf;
     }
     hull = {};
+    outside = {};
+    next = {};
+    head = {};
 
     size_t cells = dt_.number_of_cells(), k = 0;
     // Per cell in the order visited: the links found below (2 bytes a
