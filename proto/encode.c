@@ -152,17 +152,36 @@ int scp_enc_pong(scp_buf_t *b, uint64_t token) {
   return enc_token(b, SCP_PONG, token);
 }
 
-int scp_enc_job_begin(scp_buf_t *b, const scp_job_begin_t *m) {
-  int rc = scp__check_job_begin(m);
-  uint8_t *p;
-  if (rc || (rc = frame_begin(b, SCP_JOB_BEGIN, 40, &p)))
-    return rc;
+static void job_begin_write(uint8_t *p, const scp_job_begin_t *m) {
   scp__st32(p, m->job_id);
   scp__st32(p + 4, m->mode);
   scp__stf64(p + 8, m->r);
   scp__stf64(p + 16, m->theta);
   scp__st64(p + 24, m->point_count);
   scp__st32(p + 32, m->flags);
+}
+
+int scp_enc_job_begin(scp_buf_t *b, const scp_job_begin_t *m) {
+  int rc = scp__check_job_begin(m);
+  const scp_values_t *o = &m->options;
+  uint8_t *p;
+  if (rc)
+    return rc;
+  if (o->count == 0 && o->len == 0) {
+    if ((rc = frame_begin(b, SCP_JOB_BEGIN, 40, &p)))
+      return rc;
+    job_begin_write(p, m);
+    return 0;
+  }
+  /* A view of options in wire form, as the parser gives it. */
+  if (o->count == 0 || !o->data)
+    return o->count == 0 ? SCP_ERANGE : SCP_EINVAL;
+  if ((rc = scp__values_check(o->data, o->len, o->count)) ||
+      (rc = frame_begin(b, SCP_JOB_BEGIN, 48 + (uint64_t)o->len, &p)))
+    return rc;
+  job_begin_write(p, m);
+  scp__st32(p + 40, o->count);
+  memcpy(p + 48, o->data, o->len);
   return 0;
 }
 
@@ -257,6 +276,24 @@ static void values_write(uint8_t *p, const scp_value_t *values, uint32_t n) {
     }
     p += 10 + len;
   }
+}
+
+int scp_enc_job_begin_options(scp_buf_t *b, const scp_job_begin_t *m,
+                              const scp_value_t *options, uint32_t count) {
+  scp_job_begin_t plain = *m;
+  plain.options = (scp_values_t){0, NULL, 0};
+  if (count == 0)
+    return scp_enc_job_begin(b, &plain);
+  uint64_t size;
+  uint8_t *p;
+  int rc = scp__check_job_begin(m);
+  if (rc || (rc = values_size(options, count, &size)) ||
+      (rc = frame_begin(b, SCP_JOB_BEGIN, 48 + size, &p)))
+    return rc;
+  job_begin_write(p, m);
+  scp__st32(p + 40, count);
+  values_write(p + 48, options, count);
+  return 0;
 }
 
 int scp_enc_job_done(scp_buf_t *b, const scp_job_done_t *m,

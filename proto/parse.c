@@ -38,6 +38,9 @@ static int at_least(const scp_frame_t *f, uint16_t type, uint32_t n) {
   return 0;
 }
 
+static int parse_values(const uint8_t *p, size_t len, uint32_t count,
+                        scp_values_t *out);
+
 static int zero32(const uint8_t *p) {
   return scp__ld32(p) == 0 ? 0 : SCP_ERESERVED;
 }
@@ -128,7 +131,9 @@ int scp_parse_pong(const scp_frame_t *f, uint64_t *token) {
 
 int scp_parse_job_begin(const scp_frame_t *f, scp_job_begin_t *out) {
   const uint8_t *p = f->payload;
-  int rc = exact(f, SCP_JOB_BEGIN, 40);
+  /* 40 bytes, or 48 and a list of job options (PROTOCOL.md 6.3). */
+  int rc = f->length > 40 && f->length < 48 ? exact(f, SCP_JOB_BEGIN, 40)
+                                            : at_least(f, SCP_JOB_BEGIN, 40);
   if (rc || (rc = zero32(p + 36)))
     return rc;
   out->job_id = scp__ld32(p);
@@ -137,6 +142,15 @@ int scp_parse_job_begin(const scp_frame_t *f, scp_job_begin_t *out) {
   out->theta = scp__ldf64(p + 16);
   out->point_count = scp__ld64(p + 24);
   out->flags = scp__ld32(p + 32);
+  out->options = (scp_values_t){0, NULL, 0};
+  if (f->length > 40) {
+    if ((rc = zero32(p + 44)) ||
+        (rc = parse_values(p + 48, f->length - 48, scp__ld32(p + 40),
+                           &out->options)))
+      return rc;
+    if (out->options.count == 0)
+      return SCP_ERANGE;
+  }
   return scp__check_job_begin(out);
 }
 

@@ -216,6 +216,16 @@ typedef enum scp_format {
 /* Bytes per element of a format; 0 for an unknown format. */
 size_t scp_format_size(uint32_t format);
 
+/* Feature bits (PROTOCOL.md 5). JOB_OPTIONS: JOB_BEGIN may carry job
+ * options after its fixed part. */
+#define SCP_FEATURE_JOB_OPTIONS 0x1u
+/* The job options a server knows (PROTOCOL.md 6.3), by name and kind. */
+#define SCP_OPT_MAX_HOLE_EDGES "max_hole_edges"       /* u64, 0 to 100000 */
+#define SCP_OPT_BOUNDARY_RHO "boundary_rho"           /* f64, (0, 10] */
+#define SCP_OPT_BOUNDARY_ALPHA "boundary_alpha"       /* f64, (0, pi/2] */
+#define SCP_OPT_PAPER_PRUNING "paper_pruning"         /* u64, 0 or 1 */
+#define SCP_OPT_WATERTIGHT_LABELS "watertight_labels" /* u64, 0 or 1 */
+
 /* JOB_BEGIN flags. */
 #define SCP_JOB_NORMALS 0x1u
 #define SCP_JOB_NORMALS_F64 0x2u
@@ -257,6 +267,14 @@ typedef struct scp_error {
   char message[SCP_MESSAGE_MAX + 1];
 } scp_error_t;
 
+/* A value list as a view into a payload (see scp_values_begin() below). */
+typedef struct scp_values scp_values_t;
+struct scp_values {
+  uint32_t count;
+  const uint8_t *data;
+  size_t len;
+};
+
 typedef struct scp_job_begin {
   uint32_t job_id;      /* != 0 */
   uint32_t mode;        /* < SCP_MODE_COUNT */
@@ -265,6 +283,11 @@ typedef struct scp_job_begin {
   uint64_t point_count; /* 0 when unknown */
   uint32_t flags;       /* SCP_JOB_NORMALS, SCP_JOB_NORMALS_F64 (needs the
                            former) */
+  /* Job options (PROTOCOL.md 6.3), only where SCP_FEATURE_JOB_OPTIONS is
+   * in force: count 0 for none, else at least one entry. The parser fills
+   * it with a view into the payload; scp_enc_job_begin() sends such a view
+   * as it is, scp_enc_job_begin_options() an array. */
+  scp_values_t options;
 } scp_job_begin_t;
 
 typedef struct scp_job_end {
@@ -324,13 +347,9 @@ typedef struct scp_value {
   } v;
 } scp_value_t;
 
-/* A parsed value list: a view into the payload, already checked entry by
- * entry. Read it with scp_values_begin()/scp_values_next(). */
-typedef struct scp_values {
-  uint32_t count;
-  const uint8_t *data;
-  size_t len;
-} scp_values_t;
+/* A parsed value list (struct scp_values above): a view into the payload,
+ * already checked entry by entry. Read it with
+ * scp_values_begin()/scp_values_next(). */
 
 typedef struct scp_value_iter {
   const uint8_t *p;
@@ -399,6 +418,11 @@ int scp_enc_error(scp_buf_t *b, const scp_error_t *m);
 int scp_enc_ping(scp_buf_t *b, uint64_t token);
 int scp_enc_pong(scp_buf_t *b, uint64_t token);
 int scp_enc_job_begin(scp_buf_t *b, const scp_job_begin_t *m);
+/* JOB_BEGIN with the options given as an array (m->options is ignored);
+ * with count 0, the same as scp_enc_job_begin() without options. The names
+ * must differ from each other, as in scp_enc_job_done(). */
+int scp_enc_job_begin_options(scp_buf_t *b, const scp_job_begin_t *m,
+                              const scp_value_t *options, uint32_t count);
 int scp_enc_job_end(scp_buf_t *b, const scp_job_end_t *m);
 int scp_enc_cancel(scp_buf_t *b, uint32_t job_id);
 int scp_enc_stats_request(scp_buf_t *b, uint32_t tag);

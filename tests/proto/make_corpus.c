@@ -100,6 +100,15 @@ static void job_begin(scp_buf_t *b) {
   E(scp_enc_job_begin(b, &jb));
 }
 
+/* A JOB_BEGIN with job options, as a client with the feature sends it. */
+static void job_begin_options(scp_buf_t *b) {
+  scp_job_begin_t jb = {.job_id = 9, .mode = SCP_MODE_BOUNDARY, .r = 0.18};
+  const scp_value_t o[] = {
+      {.name = SCP_OPT_MAX_HOLE_EDGES, .kind = SCP_KIND_U64, .v.u = 0},
+      {.name = SCP_OPT_BOUNDARY_ALPHA, .kind = SCP_KIND_F64, .v.f = 0.4}};
+  E(scp_enc_job_begin_options(b, &jb, o, 2));
+}
+
 static const double octahedron[18] = {1, 0, 0, -1, 0, 0, 0, 1, 0,
                                       0, -1, 0, 0, 0, 1, 0, 0, -1};
 static const uint32_t faces[24] = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4,
@@ -205,6 +214,7 @@ int main(int argc, char **argv) {
   /* Whole sessions, as each side receives them. */
   hello(&b);
   job_begin(&b);
+  job_begin_options(&b);
   points(&b);
   scp_job_end_t je = {.job_id = 7, .point_count = 6};
   E(scp_enc_job_end(&b, &je));
@@ -241,6 +251,8 @@ int main(int argc, char **argv) {
   put_buf("msg-pong.bin", ROLE_ANY, 1, &b);
   job_begin(&b);
   put_buf("msg-job-begin.bin", ROLE_ANY, 1, &b);
+  job_begin_options(&b);
+  put_buf("msg-job-begin-options.bin", ROLE_ANY, 1, &b);
   points(&b);
   put_buf("msg-points.bin", ROLE_ANY, 1, &b);
   E(scp_enc_job_end(&b, &je));

@@ -498,6 +498,41 @@ static void test_wrong_lengths(void) {
     CHECK_RC(scp_parse(&f, &m), SCP_ESHORT);
   }
 
+  /* JOB_BEGIN with job options: 41 to 47 bytes malformed; a list that
+   * does not fill the payload malformed; no entries invalid. */
+  {
+    scp_value_t o = {.name = "max_hole_edges", .kind = SCP_KIND_U64, .v.u = 3};
+    scp_job_begin_t jb = {.job_id = 2, .r = 0.2};
+    scp_buf_t ob;
+    scp_buf_init(&ob, 0);
+    CHECK_RC(scp_enc_job_begin_options(&ob, &jb, &o, 1), 0);
+    scp_frame_t g = {.type = SCP_JOB_BEGIN,
+                     .payload = ob.data + SCP_HEADER_SIZE,
+                     .length = (uint32_t)(ob.len - SCP_HEADER_SIZE)};
+    CHECK_RC(scp_parse(&g, &m), 0);
+    for (uint32_t n = 41; n < 48; n++) {
+      g.length = n;
+      CHECK_RC(scp_parse(&g, &m), SCP_ELENGTH);
+    }
+    g.length = (uint32_t)(ob.len - SCP_HEADER_SIZE) - 1;
+    CHECK_RC(scp_parse(&g, &m), SCP_ELENGTH);
+    g.length = (uint32_t)(ob.len - SCP_HEADER_SIZE);
+    pt_put32(ob.data + SCP_HEADER_SIZE + 40, 2);
+    CHECK_RC(scp_parse(&g, &m), SCP_ELENGTH);
+    pt_put32(ob.data + SCP_HEADER_SIZE + 44, 1);
+    pt_put32(ob.data + SCP_HEADER_SIZE + 40, 1);
+    CHECK_RC(scp_parse(&g, &m), SCP_ERESERVED);
+    pt_put32(ob.data + SCP_HEADER_SIZE + 44, 0);
+    g.length = 48;
+    pt_put32(ob.data + SCP_HEADER_SIZE + 40, 0);
+    CHECK_RC(scp_parse(&g, &m), SCP_ERANGE);
+    CHECK_INT_EQ(scp_err_is_fatal(SCP_ERANGE), 0);
+    /* The encoder refuses an empty view of options that claims entries. */
+    jb.options = (scp_values_t){.count = 1, .data = NULL, .len = 0};
+    CHECK_RC(scp_enc_job_begin(&ob, &jb), SCP_EINVAL);
+    scp_buf_free(&ob);
+  }
+
   /* ERROR and JOB_ERROR whose text length lies about the payload. */
   scp_error_t e = {.code = SCP_WIRE_BUSY};
   strcpy(e.message, "abc");
