@@ -65,6 +65,15 @@ extern "C" void sc_params_init(sc_params_t *p) {
   p->boundary_alpha = sc::kDefaultAlpha;
 }
 
+extern "C" int sc_params_check(const sc_params_t *p, char *msg,
+                               size_t msg_len) {
+  if (!p) {
+    sc::set_msg(msg, msg_len, "%s", sc_strerror(SC_EINVALID_ARGUMENT));
+    return SC_EINVALID_ARGUMENT;
+  }
+  return sc::check_params(p, msg, msg_len);
+}
+
 extern "C" const char *sc_path_name(int path) {
   static const char *const names[SC_PATH_COUNT_] = {
       "shortcrust", "cocone", "boundary", "watertight", "watertight-fill"};

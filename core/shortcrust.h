@@ -150,6 +150,10 @@ typedef struct sc_params {
 
 /* Fills *p with the documented defaults. */
 void sc_params_init(sc_params_t *p);
+/* Checks every field of *p against the ranges documented above, as
+ * sc_reconstruct() does: SC_OK, or SC_EINVALID_ARGUMENT with the reason
+ * in msg (when msg is not NULL). */
+int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
 
 /* Diagnostics of one reconstruction (ALGORITHM.md section 7). */
 typedef struct sc_diag {

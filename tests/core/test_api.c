@@ -1,6 +1,6 @@
 /*
- * The C boundary: error names, streaming against one call, threads,
- * progress and cancellation at every stage, state errors.
+ * The C boundary: error names, the parameter check, streaming against one
+ * call, threads, progress and cancellation at every stage, state errors.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -83,6 +83,23 @@ int main(void) {
   CHECK(strcmp(sc_stage_name(SC_STAGE_DELAUNAY), "delaunay") == 0);
   CHECK(strcmp(sc_stage_name(SC_STAGE_COUNT), "?") == 0);
   CHECK(sc_estimate_bytes(2000000) > sc_estimate_bytes(1000000));
+
+  /* sc_params_check() takes the defaults and says what is out of range,
+   * as sc_reconstruct() would. */
+  {
+    sc_params_t q;
+    char why[256] = "";
+    sc_params_init(&q);
+    CHECK_EQ_INT(sc_params_check(&q, why, sizeof why), SC_OK);
+    q.boundary_rho = 11;
+    CHECK_EQ_INT(sc_params_check(&q, why, sizeof why), SC_EINVALID_ARGUMENT);
+    CHECK(strstr(why, "boundary_rho") != NULL);
+    sc_params_init(&q);
+    q.max_hole_edges = -1;
+    CHECK_EQ_INT(sc_params_check(&q, NULL, 0), SC_EINVALID_ARGUMENT);
+    CHECK_EQ_INT(sc_params_check(NULL, why, sizeof why),
+                 SC_EINVALID_ARGUMENT);
+  }
 
   double *xyz = malloc(3 * N * sizeof *xyz);
   sc_sample_surface(SC_SURF_TORUS, SC_DENSITY_UNIFORM, N, 11, xyz);
