@@ -28,6 +28,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* pi / 2, the largest boundary_alpha (M_PI is not C11). */
+#define SCD_HALF_PI 1.5707963267948966
+
 static void process(scd_conn_t *c);
 static void flush(scd_conn_t *c);
 static void pump(scd_conn_t *c);
@@ -695,7 +698,7 @@ static void on_hello(scd_conn_t *c, const scp_frame_t *f) {
   scp_welcome_t w;
   memset(&w, 0, sizeof w);
   w.version = SCP_VERSION;
-  w.features = 0;
+  w.features = h.features & SCP_FEATURE_JOB_OPTIONS;
   w.max_frame = h.max_frame < srv->cfg.max_frame ? h.max_frame
                                                  : srv->cfg.max_frame;
   w.max_jobs = srv->cfg.max_jobs;
@@ -703,6 +706,7 @@ static void on_hello(scd_conn_t *c, const scp_frame_t *f) {
   if (sent(c, scp_enc_welcome(&c->out, &w)) != 0)
     return;
   c->max_frame = w.max_frame;
+  c->features = w.features;
   scp_decoder_set_max_frame(c->dec, w.max_frame);
   c->out.max_frame = c->wbuf.max_frame = w.max_frame;
   c->state = SCD_CONN_READY;
@@ -745,12 +749,89 @@ static void fmt_bytes(char *buf, size_t len, uint64_t b) {
   snprintf(buf, len, "%.1f MiB", (double)b / (1024.0 * 1024.0));
 }
 
+/* The job options of a JOB_BEGIN (PROTOCOL.md 6.3), applied to *p: 0, or
+ * the wire code to refuse the job with, and the reason in why. */
+static uint32_t apply_options(const scp_values_t *options, sc_params_t *p,
+                              char *why, size_t len) {
+  static const struct {
+    const char *name;
+    uint32_t kind;
+  } known[] = {{SCP_OPT_MAX_HOLE_EDGES, SCP_KIND_U64},
+               {SCP_OPT_BOUNDARY_RHO, SCP_KIND_F64},
+               {SCP_OPT_BOUNDARY_ALPHA, SCP_KIND_F64},
+               {SCP_OPT_PAPER_PRUNING, SCP_KIND_U64},
+               {SCP_OPT_WATERTIGHT_LABELS, SCP_KIND_U64}};
+  const size_t nknown = sizeof known / sizeof known[0];
+  unsigned seen = 0;
+  scp_value_iter_t it;
+  scp_value_t v;
+  scp_values_begin(options, &it);
+  while (scp_values_next(&it, &v)) {
+    size_t k = 0;
+    while (k < nknown && strcmp(v.name, known[k].name) != 0)
+      k++;
+    if (k == nknown) {
+      snprintf(why, len, "job option %s is not supported by this server",
+               v.name);
+      return SCP_WIRE_UNSUPPORTED;
+    }
+    if (seen & (1u << k))
+      continue; /* a name given twice takes its first value */
+    seen |= 1u << k;
+    if (v.kind != known[k].kind) {
+      snprintf(why, len, "job option %s must be %s", v.name,
+               known[k].kind == SCP_KIND_U64 ? "an unsigned integer (u64)"
+                                             : "a number (f64)");
+      return SCP_WIRE_INVALID;
+    }
+    int bad = 0;
+    switch (k) {
+    case 0:
+      bad = v.v.u > 100000;
+      p->max_hole_edges = bad ? 0 : (int)v.v.u;
+      break;
+    case 1:
+      bad = !(v.v.f > 0 && v.v.f <= 10);
+      p->boundary_rho = v.v.f;
+      break;
+    case 2:
+      bad = !(v.v.f > 0 && v.v.f <= SCD_HALF_PI);
+      p->boundary_alpha = v.v.f;
+      break;
+    case 3:
+      bad = v.v.u > 1;
+      p->paper_pruning = (int)(v.v.u & 1);
+      break;
+    default:
+      bad = v.v.u > 1;
+      p->watertight_labels = (int)(v.v.u & 1);
+      break;
+    }
+    if (bad) {
+      if (known[k].kind == SCP_KIND_U64)
+        snprintf(why, len, "job option %s out of range: %llu", v.name,
+                 (ull)v.v.u);
+      else
+        snprintf(why, len, "job option %s out of range: %g", v.name, v.v.f);
+      return SCP_WIRE_INVALID;
+    }
+  }
+  /* Whatever the ranges above let through, the core must take too. */
+  if (sc_params_check(p, why, len) != SC_OK)
+    return SCP_WIRE_INVALID;
+  return 0;
+}
+
 static void on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
   scd_server_t *srv = c->srv;
   scp_job_begin_t m;
   memset(&m, 0, sizeof m);
   int rc = scp_parse_job_begin(f, &m);
   uint32_t id = m.job_id;
+  /* Options are only for connections that agreed on them: without the
+   * feature, a JOB_BEGIN longer than 40 bytes is malformed. */
+  if (f->length > 40 && !(c->features & SCP_FEATURE_JOB_OPTIONS))
+    rc = SCP_ELENGTH;
   if (rc != 0) {
     if (scp_err_is_fatal(rc)) {
       protocol_fatal(c, rc, 0, f->type);
@@ -794,6 +875,19 @@ static void on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
                scp_mode_name(m.mode));
     return;
   }
+  sc_params_t params;
+  sc_params_init(&params);
+  params.mode = (sc_mode_t)m.mode;
+  params.r = m.r;
+  if (m.theta != 0)
+    params.cocone_theta = m.theta;
+  params.threads = 1;
+  char why[SCP_MESSAGE_MAX + 1];
+  uint32_t refused = apply_options(&m.options, &params, why, sizeof why);
+  if (refused) {
+    refuse_job(c, id, refused, "%s", why);
+    return;
+  }
   if (m.point_count > srv->max_points) {
     refuse_job(c, id, SCP_WIRE_LIMIT,
                "job of %llu points; this server takes at most %llu per job",
@@ -825,11 +919,7 @@ static void on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
     scd_conn_close_now(c, "out of memory");
     return;
   }
-  t->params.mode = (sc_mode_t)m.mode;
-  t->params.r = m.r;
-  if (m.theta != 0)
-    t->params.cocone_theta = m.theta;
-  t->params.threads = 1;
+  t->params = params;
   t->owner = j;
   j->task = t;
   j->phase = SCD_JOB_UPLOADING;

@@ -150,6 +150,7 @@ struct scd_conn {
   int writing;
   uv_shutdown_t sreq;
   uint32_t max_frame;
+  uint64_t features;       /* feature bits in force (WELCOME's) */
 
   scd_job_t *jobs;
   unsigned njobs;

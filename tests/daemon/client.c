@@ -215,7 +215,7 @@ int scdt_handshake_v(scdt_conn_t *c, uint16_t vmin, uint16_t vmax,
                      uint32_t max_frame, int timeout_ms) {
   scp_hello_t h = {.version_min = vmin,
                    .version_max = vmax,
-                   .features = 0,
+                   .features = c->features,
                    .max_frame = max_frame};
   if (scp_enc_hello(&c->out, &h) != 0)
     return -1;
@@ -281,6 +281,8 @@ void scdt_job_reset(scdt_job_t *j) {
   j->flags = keep.flags;
   j->format = keep.format;
   j->declare = keep.declare;
+  j->options = keep.options;
+  j->noptions = keep.noptions;
 }
 
 #define SCDT_IO_MS 60000
@@ -293,7 +295,7 @@ int scdt_job_begin(scdt_conn_t *c, scdt_job_t *j) {
                        .point_count = j->declare ? j->n : 0,
                        .flags = j->flags};
   j->sent = 0;
-  if (scp_enc_job_begin(&c->out, &m) != 0)
+  if (scp_enc_job_begin_options(&c->out, &m, j->options, j->noptions) != 0)
     return -1;
   return scdt_flush(c, SCDT_IO_MS);
 }

@@ -33,6 +33,8 @@ typedef struct scdt_conn {
   scdt_frame_t *qhead, *qtail; /* frames read, not yet taken */
   int eof;                     /* the server closed (or reset) */
   int dec_err;                 /* the decoder's sticky error */
+  /* Feature bits the handshake offers (default none). */
+  uint64_t features;
   /* The last ERROR frame seen by scdt_collect(). */
   int got_error;
   scp_error_t last_error;
@@ -74,6 +76,8 @@ typedef struct scdt_job {
   uint32_t flags;      /* SCP_JOB_NORMALS ... */
   uint32_t format;     /* SCP_F64_XYZ unless set */
   int declare;         /* send point_count in JOB_BEGIN (default 1) */
+  const scp_value_t *options; /* job options for JOB_BEGIN (default none) */
+  uint32_t noptions;
   uint64_t sent;       /* points sent so far */
 
   int accepted;
