@@ -53,8 +53,25 @@ void sc_cli_job_usage_params(FILE *f) {
           "      --r R             shortcrust sampling parameter, in (0, 0.5) "
           "(default %g)\n"
           "      --theta DEG       cocone half-width in degrees, in (0, 90) "
-          "(default %g)\n",
-          sc_cli_mode_name(d.mode), d.r, d.cocone_theta * 180 / SC_PI);
+          "(default %g)\n"
+          "      --max-hole N      close holes of at most N edges, 0 = never "
+          "(default %d)\n"
+          "      --paper-pruning   prune every edge with a single candidate, "
+          "as in the paper\n"
+          "      --labels          watertight mode: close the surface by "
+          "labelling Delaunay\n"
+          "                        cells inside or outside first (default: "
+          "least-area\n"
+          "                        patches first, labelling where they "
+          "cannot close it)\n"
+          "      --rho RHO         boundary detection: ratio of cocone extent "
+          "to pole height,\n"
+          "                        in (0, 10] (default %g)\n"
+          "      --alpha DEG       boundary detection: largest angle between "
+          "neighbouring\n"
+          "                        poles, in (0, 90] degrees (default %g)\n",
+          sc_cli_mode_name(d.mode), d.r, d.cocone_theta * 180 / SC_PI,
+          d.max_hole_edges, d.boundary_rho, d.boundary_alpha * 180 / SC_PI);
 }
 
 void sc_cli_job_usage_output(FILE *f) {
@@ -68,7 +85,36 @@ void sc_cli_job_usage_output(FILE *f) {
 
 int sc_cli_job_option(sc_cli_job_opts_t *o, int c, const char *arg) {
   double v;
+  long l;
   switch (c) {
+  case SC_CLI_OPT_MAX_HOLE:
+    if (sc_cli_parse_int("--max-hole", arg, 0, 100000, &l) < 0)
+      return -1;
+    o->params.max_hole_edges = (int)l;
+    return 1;
+  case SC_CLI_OPT_PAPER:
+    o->params.paper_pruning = 1;
+    return 1;
+  case SC_CLI_OPT_LABELS:
+    o->params.watertight_labels = 1;
+    return 1;
+  case SC_CLI_OPT_RHO:
+    if (sc_cli_parse_double("--rho", arg, &o->params.boundary_rho) < 0)
+      return -1;
+    if (!(o->params.boundary_rho > 0)) {
+      sc_cli_error("--rho: must be positive, got %s", arg);
+      return -1;
+    }
+    return 1;
+  case SC_CLI_OPT_ALPHA:
+    if (sc_cli_parse_double("--alpha", arg, &v) < 0)
+      return -1;
+    if (!(v > 0)) {
+      sc_cli_error("--alpha: must be positive, got %s", arg);
+      return -1;
+    }
+    o->params.boundary_alpha = v * SC_PI / 180;
+    return 1;
   case 'o':
     o->out_path = arg;
     return 1;

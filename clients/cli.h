@@ -39,7 +39,8 @@ int sc_cli_parse_int(const char *opt, const char *arg, long min, long max,
 
 /*
  * The options every mesh-producing subcommand takes: -o, -m, --r, --theta,
- * --report, --ascii, --no-normals, -q. A subcommand lists
+ * --max-hole, --paper-pruning, --labels, --rho, --alpha, --report, --ascii,
+ * --no-normals, -q. A subcommand lists
  * SC_CLI_JOB_LONG_OPTIONS in its getopt_long table (and "o:m:q" in its short
  * options), numbers its own long options from SC_CLI_OPT_OWN, and passes
  * each getopt_long result to sc_cli_job_option() first.
@@ -56,6 +57,11 @@ enum {
   SC_CLI_OPT_REPORT,
   SC_CLI_OPT_ASCII,
   SC_CLI_OPT_NO_NORMALS,
+  SC_CLI_OPT_MAX_HOLE,
+  SC_CLI_OPT_PAPER,
+  SC_CLI_OPT_LABELS,
+  SC_CLI_OPT_RHO,
+  SC_CLI_OPT_ALPHA,
   SC_CLI_OPT_OWN
 };
 
@@ -67,10 +73,15 @@ enum {
       {"report", required_argument, NULL, SC_CLI_OPT_REPORT},                \
       {"ascii", no_argument, NULL, SC_CLI_OPT_ASCII},                        \
       {"no-normals", no_argument, NULL, SC_CLI_OPT_NO_NORMALS},              \
+      {"max-hole", required_argument, NULL, SC_CLI_OPT_MAX_HOLE},            \
+      {"paper-pruning", no_argument, NULL, SC_CLI_OPT_PAPER},                \
+      {"labels", no_argument, NULL, SC_CLI_OPT_LABELS},                      \
+      {"rho", required_argument, NULL, SC_CLI_OPT_RHO},                      \
+      {"alpha", required_argument, NULL, SC_CLI_OPT_ALPHA},                  \
       {"quiet", no_argument, NULL, 'q'}
 
 /* The help lines of the shared options: those that choose the job (-o,
- * -m, --r, --theta, with their defaults), and those about the output
+ * -m, --r, --theta to --alpha, with their defaults), and those about the output
  * (--report to --help). A subcommand prints its own options between. */
 void sc_cli_job_usage_params(FILE *f);
 void sc_cli_job_usage_output(FILE *f);

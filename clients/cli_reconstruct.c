@@ -28,26 +28,9 @@ static void usage(FILE *f) {
         f);
   sc_cli_job_usage_params(f);
   fprintf(f,
-          "      --max-hole N      close holes of at most N edges, 0 = never "
-          "(default %d)\n"
-          "      --paper-pruning   prune every edge with a single candidate, "
-          "as in the paper\n"
-          "      --labels          watertight mode: close the surface by "
-          "labelling Delaunay\n"
-          "                        cells inside or outside first (default: "
-          "least-area\n"
-          "                        patches first, labelling where they "
-          "cannot close it)\n"
-          "      --rho RHO         boundary detection: ratio of cocone extent "
-          "to pole height,\n"
-          "                        in (0, 10] (default %g)\n"
-          "      --alpha DEG       boundary detection: largest angle between "
-          "neighbouring\n"
-          "                        poles, in (0, 90] degrees (default %g)\n"
           "  -j, --threads N       threads for the Delaunay triangulation, 0 = "
           "one per core\n"
           "                        (default %d)\n",
-          d.max_hole_edges, d.boundary_rho, d.boundary_alpha * 180 / SC_PI,
           d.threads);
   sc_cli_job_usage_output(f);
   fputs("Progress goes to stderr when it is a terminal; the summary goes to\n"
@@ -56,21 +39,8 @@ static void usage(FILE *f) {
         f);
 }
 
-enum {
-  OPT_MAX_HOLE = SC_CLI_OPT_OWN,
-  OPT_PAPER,
-  OPT_RHO,
-  OPT_ALPHA,
-  OPT_LABELS
-};
-
 static const struct option long_options[] = {
     SC_CLI_JOB_LONG_OPTIONS,
-    {"max-hole", required_argument, NULL, OPT_MAX_HOLE},
-    {"paper-pruning", no_argument, NULL, OPT_PAPER},
-    {"labels", no_argument, NULL, OPT_LABELS},
-    {"rho", required_argument, NULL, OPT_RHO},
-    {"alpha", required_argument, NULL, OPT_ALPHA},
     {"threads", required_argument, NULL, 'j'},
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
@@ -81,7 +51,6 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   sc_cli_job_init(&o);
   sc_params_t *params = &o.params;
   long l;
-  double v;
 
   opterr = 0;
   int c;
@@ -92,34 +61,6 @@ int sc_cmd_reconstruct(int argc, char **argv) {
     if (shared > 0)
       continue;
     switch (c) {
-    case OPT_MAX_HOLE:
-      if (sc_cli_parse_int("--max-hole", optarg, 0, 100000, &l) < 0)
-        return SC_EXIT_USAGE;
-      params->max_hole_edges = (int)l;
-      break;
-    case OPT_PAPER:
-      params->paper_pruning = 1;
-      break;
-    case OPT_LABELS:
-      params->watertight_labels = 1;
-      break;
-    case OPT_RHO:
-      if (sc_cli_parse_double("--rho", optarg, &params->boundary_rho) < 0)
-        return SC_EXIT_USAGE;
-      if (!(params->boundary_rho > 0)) {
-        sc_cli_error("--rho: must be positive, got %s", optarg);
-        return SC_EXIT_USAGE;
-      }
-      break;
-    case OPT_ALPHA:
-      if (sc_cli_parse_double("--alpha", optarg, &v) < 0)
-        return SC_EXIT_USAGE;
-      if (!(v > 0)) {
-        sc_cli_error("--alpha: must be positive, got %s", optarg);
-        return SC_EXIT_USAGE;
-      }
-      params->boundary_alpha = v * SC_PI / 180;
-      break;
     case 'j':
       if (sc_cli_parse_int("--threads", optarg, 0, 1024, &l) < 0)
         return SC_EXIT_USAGE;

@@ -27,8 +27,8 @@ static void usage(FILE *f) {
         "triangles for the same input and options. IN may be .ply (ascii or\n"
         "binary), .xyz/.txt/.pts/.csv, .off or .obj; OUT's extension picks the\n"
         "format: .ply (binary unless --ascii), .off, .obj or .stl. The daemon\n"
-        "fills holes, prunes and finds boundaries with the defaults of\n"
-        "`reconstruct`, on one thread.\n\n"
+        "reconstructs on one thread; options that leave their default are not\n"
+        "sent, and a daemon too old to take the others refuses the job.\n\n"
         "options:\n",
         f);
   sc_cli_job_usage_params(f);
@@ -203,6 +203,18 @@ int sc_cmd_submit(int argc, char **argv) {
   cp.mode = (int)params.mode;
   cp.r = params.r;
   cp.theta = params.cocone_theta;
+  /* The job options that differ from the core's defaults, which are the
+   * daemon's. */
+  sc_params_t dflt;
+  sc_params_init(&dflt);
+  if (params.max_hole_edges != dflt.max_hole_edges)
+    cp.max_hole_edges = params.max_hole_edges;
+  if (params.boundary_rho != dflt.boundary_rho)
+    cp.boundary_rho = params.boundary_rho;
+  if (params.boundary_alpha != dflt.boundary_alpha)
+    cp.boundary_alpha = params.boundary_alpha;
+  cp.paper_pruning = params.paper_pruning;
+  cp.watertight_labels = params.watertight_labels;
   /* As doubles, so that the file gets what the local command writes. */
   cp.normals = o.normals;
   cp.progress = show_progress;

@@ -161,6 +161,7 @@ void sc_client_params_init(sc_client_params_t *p) {
   memset(p, 0, sizeof *p);
   p->mode = SC_CLIENT_MODE_COCONE;
   p->r = 0.18;
+  p->max_hole_edges = -1;
 }
 
 static double now_s(void) {
@@ -1020,7 +1021,7 @@ int sc_client_connect(const sc_client_options_t *opts, sc_client_t **out,
 
   c->hello = (scp_hello_t){.version_min = SCP_VERSION,
                            .version_max = SCP_VERSION,
-                           .features = 0,
+                           .features = SCP_FEATURE_JOB_OPTIONS,
                            .max_frame = o.max_frame ? o.max_frame : 1u << 20};
   if (scp_enc_hello(&c->out, &c->hello) < 0)
     conn_die(c, SC_CLIENT_ENOMEM, "out of memory");
@@ -1072,6 +1073,7 @@ void sc_client_get_info(const sc_client_t *c, sc_client_info_t *out) {
   out->max_frame = c->welcome.max_frame;
   out->max_jobs = c->welcome.max_jobs;
   out->max_points = c->welcome.max_points;
+  out->job_options = (c->welcome.features & SCP_FEATURE_JOB_OPTIONS) != 0;
 }
 
 unsigned sc_client_jobs_in_use(const sc_client_t *c) { return c->in_use; }
@@ -1126,7 +1128,54 @@ static int check_params(sc_client_t *c, const sc_client_params_t *p) {
                 "theta must be in (0, pi/2) radians, or 0 for the default; "
                 "got %g",
                 p->theta);
+  if (p->max_hole_edges < -1 || p->max_hole_edges > 100000)
+    return fail(c, SC_CLIENT_EINVAL,
+                "max_hole_edges must be in [0, 100000], or -1 for the "
+                "default; got %d",
+                p->max_hole_edges);
+  if (!(p->boundary_rho >= 0 && p->boundary_rho <= 10))
+    return fail(c, SC_CLIENT_EINVAL,
+                "boundary_rho must be in (0, 10], or 0 for the default; got "
+                "%g",
+                p->boundary_rho);
+  if (!(p->boundary_alpha >= 0 && p->boundary_alpha <= SCC_PI / 2))
+    return fail(c, SC_CLIENT_EINVAL,
+                "boundary_alpha must be in (0, pi/2] radians, or 0 for the "
+                "default; got %g",
+                p->boundary_alpha);
+  if (p->paper_pruning != 0 && p->paper_pruning != 1)
+    return fail(c, SC_CLIENT_EINVAL, "paper_pruning must be 0 or 1, got %d",
+                p->paper_pruning);
+  if (p->watertight_labels != 0 && p->watertight_labels != 1)
+    return fail(c, SC_CLIENT_EINVAL,
+                "watertight_labels must be 0 or 1, got %d",
+                p->watertight_labels);
   return 0;
+}
+
+/* The job options of p that differ from the daemon's defaults, into
+ * opts[5]; returns how many. */
+static uint32_t job_options(const sc_client_params_t *p, scp_value_t *opts) {
+  uint32_t n = 0;
+  if (p->max_hole_edges >= 0)
+    opts[n++] = (scp_value_t){.name = SCP_OPT_MAX_HOLE_EDGES,
+                              .kind = SCP_KIND_U64,
+                              .v.u = (uint64_t)p->max_hole_edges};
+  if (p->boundary_rho > 0)
+    opts[n++] = (scp_value_t){.name = SCP_OPT_BOUNDARY_RHO,
+                              .kind = SCP_KIND_F64,
+                              .v.f = p->boundary_rho};
+  if (p->boundary_alpha > 0)
+    opts[n++] = (scp_value_t){.name = SCP_OPT_BOUNDARY_ALPHA,
+                              .kind = SCP_KIND_F64,
+                              .v.f = p->boundary_alpha};
+  if (p->paper_pruning)
+    opts[n++] = (scp_value_t){
+        .name = SCP_OPT_PAPER_PRUNING, .kind = SCP_KIND_U64, .v.u = 1};
+  if (p->watertight_labels)
+    opts[n++] = (scp_value_t){
+        .name = SCP_OPT_WATERTIGHT_LABELS, .kind = SCP_KIND_U64, .v.u = 1};
+  return n;
 }
 
 static uint32_t free_id(sc_client_t *c) {
@@ -1170,6 +1219,18 @@ static int upload(sc_client_t *c, sc_client_job_t *j, const double *xyz) {
     return 0;
   }
   const sc_client_params_t *p = &j->params;
+  scp_value_t opts[5];
+  const uint32_t nopts = job_options(p, opts);
+  if (nopts && !(c->welcome.features & SCP_FEATURE_JOB_OPTIONS)) {
+    snprintf(j->message, sizeof j->message,
+             "UNSUPPORTED: the daemon does not take job options (%s); "
+             "leave them at their defaults or update the daemon",
+             opts[0].name);
+    j->server_code = SCP_WIRE_UNSUPPORTED;
+    j->client_done = j->server_done = 1;
+    settle(c, j, SC_CLIENT_EREFUSED);
+    return 0;
+  }
   scp_job_begin_t b = {
       .job_id = j->id,
       .mode = (uint32_t)p->mode,
@@ -1177,7 +1238,7 @@ static int upload(sc_client_t *c, sc_client_job_t *j, const double *xyz) {
       .theta = p->theta,
       .point_count = j->n,
       .flags = p->normals ? SCP_JOB_NORMALS | SCP_JOB_NORMALS_F64 : 0};
-  if (scp_enc_job_begin(&c->out, &b) < 0)
+  if (scp_enc_job_begin_options(&c->out, &b, opts, nopts) < 0)
     return fail(c, SC_CLIENT_ENOMEM, "out of memory");
   j->in_use = j->begun = 1;
   c->in_use++;

@@ -158,6 +158,7 @@ typedef struct sc_client_info {
   uint32_t max_frame;
   uint32_t max_jobs;   /* jobs in use at once on this connection */
   uint64_t max_points; /* points in one job */
+  int job_options;     /* the daemon takes job options (JOB_OPTIONS) */
 } sc_client_info_t;
 
 void sc_client_get_info(const sc_client_t *c, sc_client_info_t *out);
@@ -219,6 +220,22 @@ typedef struct sc_client_params {
   double theta;
   /* Non-zero: have the daemon send one normal per point (as doubles). */
   int normals;
+  /* Job options (PROTOCOL.md 6.3), sent only when not left at these
+   * "daemon's default" values, and only to a daemon that takes them (see
+   * sc_client_info_t.job_options; a daemon that does not gets no job: it
+   * ends SC_CLIENT_EREFUSED at once, with code UNSUPPORTED). Ranges and
+   * meanings as in sc_params_t of the core.
+   * Holes closed after extraction, at most this many edges; 0 never; -1
+   * (default) the daemon's default, 100. */
+  int max_hole_edges;
+  /* Boundary detection: in (0, 10] and (0, pi/2] radians; 0 (default)
+   * the daemon's defaults, 1.3 and pi/9. */
+  double boundary_rho;
+  double boundary_alpha;
+  /* 1: the paper's pruning; 1: watertight mode labels cells first.
+   * Default 0 for both, as on the daemon. */
+  int paper_pruning;
+  int watertight_labels;
   /* Optional. */
   sc_client_progress_fn progress;
   void *progress_user;

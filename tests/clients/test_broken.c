@@ -7,7 +7,8 @@
  * disagree, a frame for a job not in use), each costing the connection
  * with a fatal ERROR PROTOCOL sent back; a daemon that closes mid-job; and
  * the parts of the protocol a client must handle that the daemon does not
- * use (PING from the server, unknown frame types).
+ * use (PING from the server, unknown frame types); and a daemon without
+ * job options, to which a job that has some is never sent.
  *
  *   test_clients_broken DAEMON   (the daemon is not used; the harness
  *                                 wants its path)
@@ -38,7 +39,8 @@ enum {
   S_BAD_TOTALS,    /* JOB_DONE counts a triangle that never came */
   S_UNKNOWN_JOB,   /* ACCEPTED for a job id not in use */
   S_CLOSE_MID_JOB, /* closes after ACCEPTED */
-  S_GOOD           /* PING, unknown types, then the mesh */
+  S_GOOD,          /* PING, unknown types, then the mesh */
+  S_NO_OPTIONS     /* WELCOME without JOB_OPTIONS, then reads to the end */
 };
 
 typedef struct fake {
@@ -51,6 +53,7 @@ typedef struct fake {
   int got_fatal_protocol;
   int got_unknown_type_error;
   int got_pong;
+  int got_job_begin;
 } fake_t;
 
 static const double tetra[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -105,6 +108,8 @@ static int read_until(fake_t *f, uint16_t type, scp_frame_t *fr) {
       if (scp_parse_pong(fr, &token) == 0 && token == 4242)
         f->got_pong = 1;
     }
+    if (fr->type == SCP_JOB_BEGIN)
+      f->got_job_begin = 1;
     if (fr->type == type)
       return 1;
   }
@@ -154,6 +159,12 @@ static void run_script(fake_t *f) {
     b.data[SCP_HEADER_SIZE + 4] = 2; /* the version field */
     send_buf(f, &b);
     read_until(f, SCP_ERROR, &fr);
+    break;
+  case S_NO_OPTIONS:
+    welcome(f, &b);
+    send_buf(f, &b);
+    /* Until the client closes. */
+    read_until(f, 0xFFFF, &fr);
     break;
   case S_SILENT:
     /* Until the client gives up. */
@@ -359,9 +370,45 @@ static void broken_jobs(void) {
   CHECK(!f.got_fatal_protocol, "a fatal ERROR for a good stream");
 }
 
+/* A job with options against a daemon that does not take them: refused
+ * by the library, with nothing sent; the same job without them goes. */
+static void no_job_options(void) {
+  fake_t f;
+  char msg[512];
+  fake_start(&f, S_NO_OPTIONS);
+  sc_client_t *c = NULL;
+  REQUIRE(connect_fake(&f, 10000, &c, msg, sizeof msg) == 0, "connect: %s",
+          msg);
+  sc_client_info_t info;
+  sc_client_get_info(c, &info);
+  CHECK_EQ(info.job_options, 0);
+  sc_client_params_t p;
+  sc_client_params_init(&p);
+  p.mode = SC_CLIENT_MODE_BOUNDARY;
+  p.max_hole_edges = 0;
+  sc_client_job_t *j = NULL;
+  CHECK_EQ(sc_client_submit(c, &p, tetra, 4, &j), 0);
+  CHECK_EQ(sc_client_wait(c, j, 10000), SC_CLIENT_EREFUSED);
+  CHECK_MSG(sc_client_job_message(j), "UNSUPPORTED");
+  CHECK_MSG(sc_client_job_message(j), "max_hole_edges");
+  sc_client_job_free(j);
+  /* Out of range: refused before anything else. */
+  p.max_hole_edges = -2;
+  CHECK_EQ(sc_client_submit(c, &p, tetra, 4, &j), SC_CLIENT_EINVAL);
+  CHECK_MSG(sc_client_last_error(c), "max_hole_edges");
+  p.max_hole_edges = -1;
+  p.boundary_alpha = 2;
+  CHECK_EQ(sc_client_submit(c, &p, tetra, 4, &j), SC_CLIENT_EINVAL);
+  CHECK_MSG(sc_client_last_error(c), "boundary_alpha");
+  sc_client_free(c);
+  fake_finish(&f);
+  CHECK(!f.got_job_begin, "a JOB_BEGIN went to a daemon without options");
+}
+
 int main(int argc, char **argv) {
   scdt_init(argc, argv);
   handshakes();
   broken_jobs();
+  no_job_options();
   return scdt_finish();
 }

@@ -19,7 +19,8 @@ expect 1 "daemon is not running" "$sc" submit "$data/knot1_points.ply" -o "$tmp/
 start_daemon "$scd" "$sc" --workers 2
 
 expect 0 "usage: shortcrust submit" "$sc" submit --help
-for opt in --output --mode --r --theta --socket --report --ascii --no-normals --quiet; do
+for opt in --output --mode --r --theta --max-hole --paper-pruning --labels --rho --alpha \
+           --socket --report --ascii --no-normals --quiet; do
   grep -q -- "$opt" "$tmp/out" || fail "submit --help does not mention $opt"
 done
 expect 0 "submit" "$sc" --help
@@ -30,7 +31,12 @@ expect 0 "daemon alive, protocol 1" "$sc" ping --socket "$sock"
 # triangles, and the same summary but for the times.
 mkdir "$tmp/a" "$tmp/b"
 for in in knot1_points kitten_points; do
-  for mode in "--mode cocone" "--mode shortcrust --r 0.14" "--mode auto" "--mode watertight"; do
+  # The last two send job options; the daemon must apply them as the
+  # local command does (without them the meshes differ: knot1 in boundary
+  # mode has 37 small holes that --max-hole 0 leaves open).
+  for mode in "--mode cocone" "--mode shortcrust --r 0.14" "--mode auto" "--mode watertight" \
+              "--mode boundary --max-hole 0 --rho 1.2 --alpha 25" \
+              "--mode watertight --labels --paper-pruning"; do
     expect 0 "" "$sc" submit "$data/$in.ply" -o "$tmp/a/m.ply" --socket "$sock" $mode --report "$tmp/a/r.json"
     head -n 3 "$tmp/out" | sed "s|$tmp/a/||" > "$tmp/a/sum"
     expect 0 "" "$sc" reconstruct "$data/$in.ply" -o "$tmp/b/m.ply" $mode --report "$tmp/b/r.json"
@@ -68,7 +74,10 @@ expect 2 "no input file" "$sc" submit -o "$tmp/x.ply" --socket "$sock"
 expect 2 "no output file" "$sc" submit "$data/knot1_points.ply" --socket "$sock"
 expect 2 "r must be in (0, 0.5)" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --r 0.7 --socket "$sock"
 expect 2 "unknown mode 'foo'" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --mode foo
-expect 2 "unknown option '--max-hole'" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --max-hole 5
+expect 2 "unknown option '--threads'" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --threads 2
+expect 2 "--max-hole" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --max-hole 100001 --socket "$sock"
+expect 2 "boundary_rho must be in (0, 10]" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --rho 11 --socket "$sock"
+expect 2 "boundary_alpha must be in (0, pi/2]" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --alpha 120 --socket "$sock"
 expect 2 "unknown extension '.xyz'" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.xyz"
 expect 2 "unknown option '--bogus'" "$sc" stats --bogus
 expect 2 "unknown option '--json'" "$sc" ping --json
