@@ -147,9 +147,10 @@ int sc_cmd_stats(int argc, char **argv) {
     }
     printf("}\n");
   } else {
-    printf("daemon on %s: protocol %u, at most %u jobs per connection and "
-           "%llu points per job\n",
-           info.socket_path, info.version, info.max_jobs,
+    printf("daemon on %s: protocol %u%s, at most %u jobs per connection "
+           "and %llu points per job\n",
+           info.socket_path, info.version,
+           info.job_options ? " with job options" : "", info.max_jobs,
            (unsigned long long)info.max_points);
     for (size_t i = 0; i < n; i++) {
       printf("  %-28s ", v[i].name);
@@ -193,8 +194,9 @@ int sc_cmd_ping(int argc, char **argv) {
   }
   sc_client_info_t info;
   sc_client_get_info(c, &info);
-  printf("%s: daemon alive, protocol %u, round trip %.3f ms\n",
-         info.socket_path, info.version, rtt * 1e3);
+  printf("%s: daemon alive, protocol %u%s, round trip %.3f ms\n",
+         info.socket_path, info.version,
+         info.job_options ? " with job options" : "", rtt * 1e3);
   sc_client_free(c);
   return SC_EXIT_OK;
 }

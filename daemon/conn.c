@@ -934,8 +934,10 @@ static void on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
       .job_id = id,
       .queue_position = ps.busy < ps.workers ? 0 : (uint32_t)ps.queued + 1};
   sent(c, scp_enc_accepted(&c->out, &a));
-  scd_debug("job %llu:%u accepted: mode %s, %llu points announced",
-            (ull)c->id, id, scp_mode_name(m.mode), (ull)m.point_count);
+  scd_debug("job %llu:%u accepted: mode %s, %llu points announced, %u job "
+            "options",
+            (ull)c->id, id, scp_mode_name(m.mode), (ull)m.point_count,
+            m.options.count);
 }
 
 /* Hands the points gathered so far to the pool. */

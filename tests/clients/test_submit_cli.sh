@@ -25,7 +25,7 @@ for opt in --output --mode --r --theta --max-hole --paper-pruning --labels --rho
 done
 expect 0 "submit" "$sc" --help
 grep -q "stats" "$tmp/out" && grep -q "ping" "$tmp/out" || fail "--help lacks stats or ping"
-expect 0 "daemon alive, protocol 1" "$sc" ping --socket "$sock"
+expect 0 "daemon alive, protocol 1 with job options" "$sc" ping --socket "$sock"
 
 # The same mesh as the local command: the same vertices and the same
 # triangles, and the same summary but for the times.
