@@ -392,7 +392,9 @@ static void usage(FILE *f) {
       "  -k, --jobs-in-flight K  jobs in flight per connection (default 1)\n"
       "  -d, --duration S        start no job after S seconds\n"
       "      --timeout S         a job taking longer fails (default 300)\n"
-      "      --mode MODE         cocone or shortcrust (default cocone)\n"
+      "      --mode MODE         cocone, shortcrust, boundary, watertight or "
+      "auto\n"
+      "                          (default cocone)\n"
       "      --r R               shortcrust parameter (default 0.18)\n"
       "      --verify            check every mesh: indices in range and a\n"
       "                          manifold; closed, outward and of the right\n"
@@ -506,17 +508,28 @@ int main(int argc, char **argv) {
       if (cfg.timeout > 2e6)
         cfg.timeout = 2e6;
       break;
-    case OPT_MODE:
-      if (strcmp(optarg, "cocone") == 0) {
-        cfg.params.mode = SC_CLIENT_MODE_COCONE;
-      } else if (strcmp(optarg, "shortcrust") == 0) {
-        cfg.params.mode = SC_CLIENT_MODE_SHORTCRUST;
-      } else {
-        say("--mode: unknown mode '%s' (expected cocone or shortcrust)",
+    case OPT_MODE: {
+      static const struct {
+        const char *name;
+        int mode;
+      } modes[] = {{"cocone", SC_CLIENT_MODE_COCONE},
+                   {"shortcrust", SC_CLIENT_MODE_SHORTCRUST},
+                   {"boundary", SC_CLIENT_MODE_BOUNDARY},
+                   {"watertight", SC_CLIENT_MODE_WATERTIGHT},
+                   {"auto", SC_CLIENT_MODE_AUTO}};
+      size_t m = 0;
+      while (m < sizeof modes / sizeof modes[0] &&
+             strcmp(optarg, modes[m].name) != 0)
+        m++;
+      if (m == sizeof modes / sizeof modes[0]) {
+        say("--mode: unknown mode '%s' (expected cocone, shortcrust, "
+            "boundary, watertight or auto)",
             optarg);
         return 2;
       }
+      cfg.params.mode = modes[m].mode;
       break;
+    }
     case OPT_R: {
       char *end;
       cfg.params.r = strtod(optarg, &end);

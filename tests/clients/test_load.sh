@@ -28,6 +28,19 @@ done
 after=$(echo "$json" | sed 's/.*"daemon_after": {[^}]*"jobs_done_total": \([0-9]*\).*/\1/')
 [ "$after" = "$jobs" ] || fail "daemon counted $after jobs done, expected $jobs"
 
+# The modes for scans: on the closed test surfaces they too must give
+# closed meshes of the right genus.
+for mode in boundary watertight auto; do
+  "$load" --socket "$sock" --clients 1 --jobs 3 --points 2000 --mode "$mode" \
+    --verify --json > "$tmp/outm"
+  status=$?
+  [ "$status" -eq 0 ] || fail "--mode $mode exited $status: $(cat "$tmp/outm")"
+  tail -n 1 "$tmp/outm" | grep -q '"verified": 3, "verify_failures": 0,' ||
+    fail "--mode $mode: $(tail -n 1 "$tmp/outm")"
+done
+"$load" --socket "$sock" --jobs 1 --points 1000 --mode bogus > "$tmp/outb" 2>&1
+[ $? -eq 2 ] && grep -q "unknown mode 'bogus'" "$tmp/outb" || fail "--mode bogus: $(cat "$tmp/outb")"
+
 # Bounded by time: a run with an unreachable job count stops by itself.
 "$load" --socket "$sock" --clients 2 --jobs 1000000 --points 1000 --duration 1 --json > "$tmp/out2"
 status=$?
