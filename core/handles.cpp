@@ -54,6 +54,15 @@ struct Region {
     return g;
   }
 
+  // The same for the surface's own holes: the half-edge without a twin
+  // after h (one without a twin), turning through every triangle.
+  uint32_t next_hole_edge(uint32_t h) const {
+    uint32_t g = next_in_tri(h);
+    while (twin[g] != kNone)
+      g = next_in_tri(twin[g]);
+    return g;
+  }
+
   // Whether the boundary half-edges r[0..k) of the region lie on one loop.
   // One walker per half-edge steps along its loop, in turns: two meet soon
   // when they share a loop, and a walker back at its start has seen its
@@ -176,30 +185,25 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   }
   // Each cut opens loops that run partly along holes the surface already
   // had and partly along edges it cut. A handle that closes round a hole
-  // (where the scan has no samples) is cut mostly along that hole; a true
-  // handle, such as a cat's tail, is cut across sampled surface, far from
-  // any hole. Cuts of the second kind are put back.
+  // (where the scan has no samples) is cut mostly along that hole, which
+  // is longer than the cut; a true handle, such as a cat's tail, is cut
+  // across sampled surface, far from any hole or past holes shorter than
+  // the cut. Cuts of the second kind are put back.
   std::vector<uint64_t> cut_edges(n, 0), hole_edges(n, 0), longest_hole(n, 0);
   // The length of the hole each boundary half-edge of the surface is on
   // (turning about vertices through every triangle, not just the region's).
   std::vector<uint32_t> hole_len(tris.size(), 0);
-  auto next_hole_edge = [&](uint32_t h) {
-    uint32_t g = next_in_tri(h);
-    while (reg.twin[g] != kNone)
-      g = next_in_tri(reg.twin[g]);
-    return g;
-  };
   for (uint32_t h = 0; h < tris.size(); ++h) {
     if (reg.twin[h] != kNone || hole_len[h])
       continue;
     uint32_t len = 0, g = h;
     do {
       ++len;
-      g = next_hole_edge(g);
+      g = reg.next_hole_edge(g);
     } while (g != h);
     do {
       hole_len[g] = len;
-      g = next_hole_edge(g);
+      g = reg.next_hole_edge(g);
     } while (g != h);
   }
   std::vector<uint8_t> walked(tris.size(), 0);
