@@ -454,59 +454,50 @@ static const struct option long_options[] = {
     {NULL, 0, NULL, 0},
 };
 
-int main(int argc, char **argv) {
-  config_t cfg;
-  memset(&cfg, 0, sizeof cfg);
-  cfg.clients = 1;
-  cfg.in_flight = 1;
-  cfg.jobs = 0;
-  cfg.timeout = 300;
-  sc_client_params_init(&cfg.params);
-  uint64_t points = 0, v;
-  const char **files = calloc((size_t)argc + 1, sizeof *files);
-  size_t nfiles = 0;
-  if (!files)
-    return 1;
-
+/* The command line into *cfg, the files and the point count: -1 to go on,
+ * or the status to exit with (after --help, or a message). */
+static int parse_args(int argc, char **argv, config_t *cfg,
+                      const char **files, size_t *nfiles, uint64_t *points) {
+  uint64_t v;
   opterr = 0;
   int c;
   while ((c = getopt_long(argc, argv, ":c:n:p:f:k:d:hV", long_options, NULL)) !=
          -1) {
     switch (c) {
     case OPT_SOCKET:
-      cfg.socket_path = optarg;
+      cfg->socket_path = optarg;
       break;
     case 'c':
       if (parse_u64("--clients", optarg, 1, 1000, &v) < 0)
         return 2;
-      cfg.clients = (unsigned)v;
+      cfg->clients = (unsigned)v;
       break;
     case 'n':
       if (parse_u64("--jobs", optarg, 1, UINT64_MAX - 1, &v) < 0)
         return 2;
-      cfg.jobs = v;
+      cfg->jobs = v;
       break;
     case 'p':
-      if (parse_u64("--points", optarg, 100, 100000000, &points) < 0)
+      if (parse_u64("--points", optarg, 100, 100000000, points) < 0)
         return 2;
       break;
     case 'f':
-      files[nfiles++] = optarg;
+      files[(*nfiles)++] = optarg;
       break;
     case 'k':
       if (parse_u64("--jobs-in-flight", optarg, 1, 100000, &v) < 0)
         return 2;
-      cfg.in_flight = (unsigned)v;
+      cfg->in_flight = (unsigned)v;
       break;
     case 'd':
-      if (parse_seconds("--duration", optarg, &cfg.duration) < 0)
+      if (parse_seconds("--duration", optarg, &cfg->duration) < 0)
         return 2;
       break;
     case OPT_TIMEOUT:
-      if (parse_seconds("--timeout", optarg, &cfg.timeout) < 0)
+      if (parse_seconds("--timeout", optarg, &cfg->timeout) < 0)
         return 2;
-      if (cfg.timeout > 2e6)
-        cfg.timeout = 2e6;
+      if (cfg->timeout > 2e6)
+        cfg->timeout = 2e6;
       break;
     case OPT_MODE: {
       static const struct {
@@ -527,23 +518,23 @@ int main(int argc, char **argv) {
             optarg);
         return 2;
       }
-      cfg.params.mode = modes[m].mode;
+      cfg->params.mode = modes[m].mode;
       break;
     }
     case OPT_R: {
       char *end;
-      cfg.params.r = strtod(optarg, &end);
-      if (end == optarg || *end || !(cfg.params.r > 0 && cfg.params.r < 0.5)) {
+      cfg->params.r = strtod(optarg, &end);
+      if (end == optarg || *end || !(cfg->params.r > 0 && cfg->params.r < 0.5)) {
         say("--r: '%s' is not a number in (0, 0.5)", optarg);
         return 2;
       }
       break;
     }
     case OPT_VERIFY:
-      cfg.verify = 1;
+      cfg->verify = 1;
       break;
     case OPT_JSON:
-      cfg.json = 1;
+      cfg->json = 1;
       break;
     case 'h':
       usage(stdout);
@@ -559,22 +550,44 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
-  if (optind < argc && nfiles == 0) {
+  if (optind < argc && *nfiles == 0) {
     say("unexpected argument '%s'; files go after --files", argv[optind]);
     return 2;
   }
   while (optind < argc)
-    files[nfiles++] = argv[optind++];
-  if ((points == 0) == (nfiles == 0)) {
+    files[(*nfiles)++] = argv[optind++];
+  if ((*points == 0) == (*nfiles == 0)) {
     say("give either --points N or --files F... (see shortcrust-load --help)");
     return 2;
   }
-  if (cfg.jobs == 0 && cfg.duration == 0) {
+  if (cfg->jobs == 0 && cfg->duration == 0) {
     say("give --jobs J, --duration S or both");
     return 2;
   }
-  if (cfg.jobs == 0)
-    cfg.jobs = UINT64_MAX;
+  if (cfg->jobs == 0)
+    cfg->jobs = UINT64_MAX;
+  return -1;
+}
+
+int main(int argc, char **argv) {
+  config_t cfg;
+  memset(&cfg, 0, sizeof cfg);
+  cfg.clients = 1;
+  cfg.in_flight = 1;
+  cfg.jobs = 0;
+  cfg.timeout = 300;
+  sc_client_params_init(&cfg.params);
+  uint64_t points = 0;
+  const char **files = calloc((size_t)argc + 1, sizeof *files);
+  size_t nfiles = 0;
+  if (!files)
+    return 1;
+
+  int status = parse_args(argc, argv, &cfg, files, &nfiles, &points);
+  if (status >= 0) {
+    free(files);
+    return status;
+  }
 
   /* A daemon that goes away must show as an error, not kill the run. */
   signal(SIGPIPE, SIG_IGN);
