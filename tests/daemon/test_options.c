@@ -138,39 +138,36 @@ static void expect_refused(scdt_conn_t *c, uint32_t id, scp_value_t opt,
 
 static void options_refused(void) {
   scdt_conn_t *c = open_conn(SCP_FEATURE_JOB_OPTIONS);
-  expect_refused(c, 10,
-                 (scp_value_t){.name = "smoothing", .kind = SCP_KIND_U64,
-                               .v.u = 1},
-                 SCP_WIRE_UNSUPPORTED, "smoothing");
-  expect_refused(c, 11,
-                 (scp_value_t){.name = SCP_OPT_MAX_HOLE_EDGES,
-                               .kind = SCP_KIND_F64, .v.f = 10},
-                 SCP_WIRE_INVALID, "must be an unsigned integer");
-  expect_refused(c, 12,
-                 (scp_value_t){.name = SCP_OPT_MAX_HOLE_EDGES,
-                               .kind = SCP_KIND_U64, .v.u = 100001},
-                 SCP_WIRE_INVALID, "out of range");
-  expect_refused(c, 13,
-                 (scp_value_t){.name = SCP_OPT_BOUNDARY_RHO,
-                               .kind = SCP_KIND_F64, .v.f = 0},
-                 SCP_WIRE_INVALID, "out of range");
-  expect_refused(c, 14,
-                 (scp_value_t){.name = SCP_OPT_BOUNDARY_ALPHA,
-                               .kind = SCP_KIND_F64, .v.f = 2},
-                 SCP_WIRE_INVALID, "out of range");
-  expect_refused(c, 15,
-                 (scp_value_t){.name = SCP_OPT_PAPER_PRUNING,
-                               .kind = SCP_KIND_U64, .v.u = 2},
-                 SCP_WIRE_INVALID, "out of range");
+  static const struct {
+    scp_value_t opt;
+    uint32_t code;
+    const char *says;
+  } cases[] = {
+      {{.name = "smoothing", .kind = SCP_KIND_U64, .v.u = 1},
+       SCP_WIRE_UNSUPPORTED, "smoothing"},
+      {{.name = SCP_OPT_MAX_HOLE_EDGES, .kind = SCP_KIND_F64, .v.f = 10},
+       SCP_WIRE_INVALID, "must be an unsigned integer"},
+      {{.name = SCP_OPT_MAX_HOLE_EDGES, .kind = SCP_KIND_U64, .v.u = 100001},
+       SCP_WIRE_INVALID, "out of range"},
+      {{.name = SCP_OPT_BOUNDARY_RHO, .kind = SCP_KIND_F64, .v.f = 0},
+       SCP_WIRE_INVALID, "out of range"},
+      {{.name = SCP_OPT_BOUNDARY_ALPHA, .kind = SCP_KIND_F64, .v.f = 2},
+       SCP_WIRE_INVALID, "out of range"},
+      {{.name = SCP_OPT_PAPER_PRUNING, .kind = SCP_KIND_U64, .v.u = 2},
+       SCP_WIRE_INVALID, "out of range"},
+  };
+  for (uint32_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+    expect_refused(c, 10 + i, cases[i].opt, cases[i].code, cases[i].says);
   /* An empty option list in the long form: invalid, not malformed. */
   scp_buf_t b;
   scp_buf_init(&b, 1u << 20);
   scp_value_t one = {.name = "x", .kind = SCP_KIND_U64, .v.u = 0};
   scp_job_begin_t m = {.job_id = 16, .mode = SCP_MODE_COCONE, .r = 0.25};
   REQUIRE(scp_enc_job_begin_options(&b, &m, &one, 1) == 0, "encode");
-  /* Header (8 bytes), then the payload: count at 40, the entry at 48. */
-  memset(b.data + 8 + 40, 0, 4);
-  b.len = 8 + 48;
+  /* The header, then the payload: count at 40 (little-endian, as is the
+   * header's payload length at 4), the entry at 48, cut off. */
+  memset(b.data + SCP_HEADER_SIZE + 40, 0, 4);
+  b.len = SCP_HEADER_SIZE + 48;
   b.data[4] = 48, b.data[5] = b.data[6] = b.data[7] = 0;
   scdt_send_raw(c, b.data, b.len, T_MS);
   scdt_frame_t *f = scdt_recv(c, T_MS);
