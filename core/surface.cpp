@@ -1485,29 +1485,18 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
       if (has(t, v))
         visit(t);
   };
-  // reach[v]: at least the longest edge of every triangle that has had
-  // vertex v. Every point of a triangle is within its longest edge of each
-  // of its corners, so a vertex farther from a sample than twice its reach
-  // has no triangle the sample may join, and one farther than its reach
-  // plus the distance to the best triangle so far has no nearer one.
-  std::vector<double> reach(n, 0.0);
   // Also returns the sum of triangle t's edge lengths.
-  auto reaches = [&](uint32_t t) {
-    const uint32_t *v = &tris[3 * size_t(t)];
-    double l = 0, sum = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double e = std::sqrt(dist2(xyz + 3 * size_t(v[k]),
-                                       xyz + 3 * size_t(v[(k + 1) % 3])));
-      sum += e;
-      l = std::max(l, e);
-    }
+  auto edge_lengths = [&](size_t t) {
+    const uint32_t *v = &tris[3 * t];
+    double sum = 0;
     for (int k = 0; k < 3; ++k)
-      reach[v[k]] = std::max(reach[v[k]], l);
+      sum += std::sqrt(
+          dist2(xyz + 3 * size_t(v[k]), xyz + 3 * size_t(v[(k + 1) % 3])));
     return sum;
   };
   double edge_sum = 0;
   for (size_t t = 0; t < nt; ++t)
-    edge_sum += reaches(uint32_t(t));
+    edge_sum += edge_lengths(t);
   const double cell = 2 * edge_sum / double(3 * nt);
   if (!(cell > 0))
     return 0;
@@ -1559,7 +1548,7 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
   bool loops_grew = false;
   // Each triangle near a sample is looked at once, though it is in the
   // stars of three vertices.
-  std::vector<uint32_t> stamp;
+  std::vector<uint32_t> stamp, vstamp(n, UINT32_MAX);
   for (uint32_t s = 0; s < n; ++s) {
     progress.tick(s, n);
     if (used[s])
@@ -1567,8 +1556,9 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     const double *p = xyz + 3 * size_t(s);
     stamp.resize(tris.size() / 3, UINT32_MAX);
     // The nearest triangle, if the sample is closer to it than its longest
-    // edge (farther samples are outliers and stay out), among those with a
-    // vertex in the grid cells around the sample; the first found of equals.
+    // edge (farther samples are outliers and stay out), among those around
+    // the used vertex nearest to the sample: the triangles with a corner at
+    // that vertex or at one of its neighbours. (The first found of equals.)
     double best = std::numeric_limits<double>::infinity(), bw[3] = {0, 0, 0};
     uint32_t bt = UINT32_MAX;
     auto consider = [&](uint32_t t) {
@@ -1599,31 +1589,47 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
         std::copy(w, w + 3, bw);
       }
     };
-    // The sample's own grid cell first, then the 26 around it: the best
-    // triangle of its own cell lets most vertices of the others be passed
-    // over. (The order decides only between triangles exactly as near,
-    // such as the fan around the vertex nearest to the sample.)
-    for (int o = 0; o < 27; ++o) {
-      const int j = o == 0 ? 13 : o <= 13 ? o - 1 : o;
+    // The nearest used vertex, in the sample's grid cell and the 26 around
+    // it (of equals, the first in the grid).
+    double near = std::numeric_limits<double>::infinity();
+    uint32_t nu = UINT32_MAX;
+    for (int j = 0; j < 27; ++j) {
       const Run &run = runs[slot(key(p, j / 9 - 1, j / 3 % 3 - 1, j % 3 - 1))];
       for (uint32_t i = run.first; i < run.last; ++i) {
         const uint32_t u = grid[i].second;
-        // Vertices none of whose triangles can be taken (see reach), with
-        // a margin far above rounding: leaving out triangles that cannot
-        // win changes nothing.
-        const double du = std::sqrt(dist2(p, xyz + 3 * size_t(u))),
-                     lu = reach[u] * (1 + 1e-6);
-        if (du > 2 * lu || (du > lu && (du - lu) * (du - lu) >
-                                           best * (1 + 1e-6)))
-          continue;
-        for_star(u, [&](uint32_t t) {
-          if (stamp[t] != s) {
-            stamp[t] = s;
-            consider(t);
-          }
-        });
+        const double d = dist2(p, xyz + 3 * size_t(u));
+        if (d < near)
+          near = d, nu = u;
       }
     }
+    if (nu == UINT32_MAX)
+      continue;
+    auto visit = [&](uint32_t t) {
+      if (stamp[t] != s) {
+        stamp[t] = s;
+        consider(t);
+      }
+    };
+    vstamp[nu] = s;
+    for_star(nu, [&](uint32_t t) {
+      const uint32_t *v = &tris[3 * size_t(t)];
+      for (int k = 0; k < 3; ++k)
+        if (vstamp[v[k]] != s) {
+          vstamp[v[k]] = s;
+          for_star(v[k], visit);
+        }
+      visit(t);
+    });
+    // None near enough there (the sample is off the edge of the surface,
+    // or nearer another layer of it than its own): every triangle with a
+    // corner in those grid cells.
+    if (bt == UINT32_MAX)
+      for (int j = 0; j < 27; ++j) {
+        const Run &run =
+            runs[slot(key(p, j / 9 - 1, j / 3 % 3 - 1, j % 3 - 1))];
+        for (uint32_t i = run.first; i < run.last; ++i)
+          for_star(grid[i].second, visit);
+      }
     if (bt == UINT32_MAX)
       continue;
     // Split the triangle at the sample: into three when the closest point
@@ -1640,14 +1646,12 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     auto set = [&](uint32_t t, uint32_t a, uint32_t b, uint32_t c) {
       tris[3 * size_t(t)] = a, tris[3 * size_t(t) + 1] = b,
                        tris[3 * size_t(t) + 2] = c;
-      reaches(t);
     };
     auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
       uint32_t t = uint32_t(tris.size() / 3);
       tris.push_back(a), tris.push_back(b), tris.push_back(c);
       gained[a].push_back(t), gained[b].push_back(t), gained[c].push_back(t);
       surf.component.push_back(surf.component[bt]);
-      reaches(t);
       return t;
     };
     // Three triangles for one, or four for two: one more vertex, three
