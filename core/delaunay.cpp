@@ -26,6 +26,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <tuple>
 
 namespace sc {
 namespace {
@@ -416,10 +417,18 @@ private:
   }
 
   V3 centre(Ch c, sc_diag_t *diag) const {
+    // Taken in the order of the vertex numbers: how a cell happens to order
+    // its vertices depends on the order of insertion, and on nearly flat
+    // cells the rounding of the centre is enough to change the surface.
+    Vh v[4] = {c->vertex(0), c->vertex(1), c->vertex(2), c->vertex(3)};
+    auto order = [&](int i, int j) {
+      if (v[j]->info().idx < v[i]->info().idx)
+        std::swap(v[i], v[j]);
+    };
+    order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
     bool guarded;
-    V3 cc = cell_circumcentre(v3(c->vertex(0)->point()), v3(c->vertex(1)->point()),
-                              v3(c->vertex(2)->point()), v3(c->vertex(3)->point()),
-                              guarded);
+    V3 cc = cell_circumcentre(v3(v[0]->point()), v3(v[1]->point()),
+                              v3(v[2]->point()), v3(v[3]->point()), guarded);
     if (guarded && diag)
       ++diag->degenerate_cells;
     return cc;
@@ -501,7 +510,13 @@ private:
           continue;
         V3 dv = cc - v3(v->point());
         float d2 = float(norm2(dv));
-        if (d2 > d.best) {
+        // Of Voronoi vertices equally far in single precision, the first in
+        // the order of the coordinates: the order of the cells in memory
+        // depends on the order of insertion.
+        if (d2 > d.best ||
+            (d2 == d.best &&
+             std::tie(dv.x, dv.y, dv.z) >
+                 std::tie(d.pole[0], d.pole[1], d.pole[2]))) {
           d.best = d2;
           d.pole[0] = dv.x, d.pole[1] = dv.y, d.pole[2] = dv.z;
         }
