@@ -175,6 +175,26 @@ struct XyzMap {
   }
 };
 
+// Sorts point indices along a Hilbert curve of their points (CGAL's median
+// policy).
+void hilbert_sort(const double *xyz, std::vector<uint32_t> &idx) {
+  CGAL::hilbert_sort(idx.begin(), idx.end(),
+                     CGAL::Spatial_sort_traits_adapter_3<K, XyzMap>(
+                         XyzMap{xyz}));
+}
+
+// The round of point i in a biased randomized insertion order: r with
+// probability 3/4^(r+1), from a hash of the index (splitmix64's finaliser),
+// so that the order depends on nothing else.
+constexpr int kRounds = 24;
+inline int brio_round(uint32_t i) {
+  uint64_t z = uint64_t(i) + 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return z == 0 ? kRounds : std::min(kRounds, __builtin_ctzll(z) / 2);
+}
+
 // The thresholds of the candidate tests, computed once from the parameters.
 struct Criteria {
   int mode;
@@ -277,30 +297,42 @@ public:
 
   void insert(const double *xyz, size_t first, size_t n,
               Progress &progress) override {
-    // One spatial sort of the whole range, then batches along it: the
-    // batches give progress and cancellation points, and each continues
+    // A biased randomized insertion order (Amenta, Choi and Rote), the one
+    // CGAL's spatial_sort() makes: rounds, each a quarter of the size of
+    // the next, each in Hilbert order. It is drawn from one Hilbert sort of
+    // the range, whose subsequences are in Hilbert order too; when the range
+    // is the whole input, that sort is also the vertex numbering (see
+    // number_vertices()), which then costs no second sort. Batches along
+    // the order give progress and cancellation points, and each continues
     // where the last one ended, so insertion keeps the locality of a single
     // sorted insert.
-    std::vector<Point> pts;
-    pts.reserve(n);
-    for (size_t i = first; i < first + n; ++i)
-      pts.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-    std::vector<std::size_t> order(n);
-    std::iota(order.begin(), order.end(), std::size_t(0));
-    typedef CGAL::Spatial_sort_traits_adapter_3<
-        K, CGAL::Pointer_property_map<Point>::const_type>
-        SortTraits;
-    CGAL::spatial_sort(order.begin(), order.end(),
-                       SortTraits(CGAL::make_property_map(
-                           static_cast<const std::vector<Point> &>(pts))));
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), uint32_t(first));
+    hilbert_sort(xyz, order);
+    std::vector<uint32_t> brio(n);
+    {
+      std::array<size_t, kRounds + 1> start{};
+      for (uint32_t i : order)
+        ++start[size_t(kRounds - brio_round(i)) + 1];
+      for (int r = 0; r < kRounds; ++r)
+        start[size_t(r) + 1] += start[size_t(r)];
+      for (uint32_t i : order)
+        brio[start[size_t(kRounds - brio_round(i))]++] = i;
+    }
+    if (first == 0)
+      hilbert_.swap(order);
+    else
+      hilbert_.clear();
+    order = {};
     const size_t batch = std::max<size_t>(1u << 14, n / 64);
     Ch hint;
     for (size_t done = 0; done < n; done += batch) {
       progress.report(double(done) / double(n));
       size_t m = std::min(batch, n - done);
       for (size_t k = done; k < done + m; ++k) {
-        Vh v = dt_.insert(pts[order[k]], hint);
-        v->info().idx = uint32_t(first + order[k]);
+        const double *p = xyz + 3 * size_t(brio[k]);
+        Vh v = dt_.insert(Point(p[0], p[1], p[2]), hint);
+        v->info().idx = brio[k];
         hint = v->cell();
       }
     }
@@ -356,24 +388,30 @@ private:
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
 
-  // Numbers the vertices 0, 1, ... in the Hilbert order of their points
-  // (ties by input index) and fills to_input (vertex number -> input index).
+  // Numbers the vertices 0, 1, ... in the Hilbert order of all the points
+  // (indices 0 .. n-1 sorted; of equal points, the vertex keeps the first
+  // index) and fills to_input (vertex number -> input index).
   void number_vertices(const double *xyz, size_t n,
                        std::vector<uint32_t> &to_input) {
-    // The vertices' indices in increasing order (the sort below starts
-    // from an order that depends only on the points), without sorting.
+    std::vector<uint32_t> order;
+    if (hilbert_.size() == n) {
+      order.swap(hilbert_);
+    } else {
+      order.resize(n);
+      std::iota(order.begin(), order.end(), 0u);
+      hilbert_sort(xyz, order);
+    }
+    hilbert_ = {};
     std::vector<uint8_t> is_vertex(n, 0);
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v)
       is_vertex[v->info().idx] = 1;
     to_input.clear();
     to_input.reserve(dt_.number_of_vertices());
-    for (size_t i = 0; i < n; ++i)
+    for (uint32_t i : order)
       if (is_vertex[i])
-        to_input.push_back(uint32_t(i));
-    CGAL::hilbert_sort(to_input.begin(), to_input.end(),
-                       CGAL::Spatial_sort_traits_adapter_3<K, XyzMap>(
-                           XyzMap{xyz}));
+        to_input.push_back(i);
+    order = {};
     std::vector<uint32_t> rank(n);
     for (size_t i = 0; i < to_input.size(); ++i)
       rank[to_input[i]] = uint32_t(i);
@@ -1187,6 +1225,9 @@ private:
   }
 
   DT dt_;
+  // The Hilbert order of the points 0 .. n-1 when they were inserted as one
+  // range (see insert()); empty otherwise.
+  std::vector<uint32_t> hilbert_;
   std::vector<Vh> vh_; // vertex number -> handle, while closing
   std::vector<Ch> star_; // scratch of repair_vertex()
   std::vector<uint32_t> parent_, size_;
