@@ -474,8 +474,15 @@ private:
 
   // Outward unit normal of the hull facet of infinite cell c.
   V3 hull_normal(Ch c, int inf, V3 *pts) const {
+    // From the corner with the smallest vertex number, in the cell's cyclic
+    // order, so that the rounding does not depend on the order of insertion.
+    int first = 0;
+    for (int k = 1; k < 3; ++k)
+      if (c->vertex((inf + 1 + k) % 4)->info().idx <
+          c->vertex((inf + 1 + first) % 4)->info().idx)
+        first = k;
     for (int k = 0; k < 3; ++k)
-      pts[k] = v3(c->vertex((inf + 1 + k) % 4)->point());
+      pts[k] = v3(c->vertex((inf + 1 + (first + k) % 3) % 4)->point());
     V3 n = cross(pts[1] - pts[0], pts[2] - pts[0]);
     Ch inner = c->neighbor(inf);
     V3 o = v3(inner->vertex(inner->index(c))->point());
@@ -525,6 +532,10 @@ private:
       int inf = c->index(dt_.infinite_vertex());
       V3 pts[3];
       V3 nrm = hull_normal(c, inf, pts);
+      // On a grid of 2^-30: sums of such numbers are exact, so they do not
+      // depend on the order of the cells in memory.
+      for (double *x : {&nrm.x, &nrm.y, &nrm.z})
+        *x = std::ldexp(std::nearbyint(std::ldexp(*x, 30)), -30);
       for (int k = 0; k < 3; ++k) {
         VertexData &d = c->vertex((inf + 1 + k) % 4)->info();
         d.pole[0] += nrm.x, d.pole[1] += nrm.y, d.pole[2] += nrm.z;

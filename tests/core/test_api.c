@@ -139,8 +139,9 @@ int main(void) {
 
   /* A grid on the faces of a cube is full of cospherical points, where the
    * order of the cells in memory (which differs between one insertion and
-   * chunks) could break ties: the meshes must still be the same array, in
-   * every mode. */
+   * chunks) could break ties, and every point is on the hull, where the
+   * normal sums the hull facets' in that order: the meshes must still be
+   * the same arrays, normals too, in every mode. */
   {
     enum { G = 24 };
     double *grid = malloc(3 * 6 * G * G * sizeof *grid);
@@ -173,6 +174,9 @@ int main(void) {
             one->triangle_count == chunked->triangle_count &&
             memcmp(one->triangles, chunked->triangles,
                    3 * one->triangle_count * sizeof *one->triangles) == 0);
+      CHECK(one && chunked && one->normals && chunked->normals &&
+            memcmp(one->normals, chunked->normals,
+                   3 * ng * sizeof *one->normals) == 0);
       sc_mesh_free(one);
       sc_mesh_free(chunked);
     }
