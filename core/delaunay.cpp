@@ -311,11 +311,13 @@ public:
     hilbert_sort(xyz, order);
     std::vector<uint32_t> brio(n);
     {
-      std::array<size_t, kRounds + 1> start{};
+      // A counting sort by round, the last (largest) round last: bucket
+      // kRounds - r, of kRounds + 1, starts at start[kRounds - r].
+      std::array<size_t, kRounds + 2> start{};
       for (uint32_t i : order)
         ++start[size_t(kRounds - brio_round(i)) + 1];
-      for (int r = 0; r < kRounds; ++r)
-        start[size_t(r) + 1] += start[size_t(r)];
+      for (int b = 0; b <= kRounds; ++b)
+        start[size_t(b) + 1] += start[size_t(b)];
       for (uint32_t i : order)
         brio[start[size_t(kRounds - brio_round(i))]++] = i;
     }
