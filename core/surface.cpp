@@ -1485,7 +1485,7 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
       if (has(t, v))
         visit(t);
   };
-  // Also returns the sum of triangle t's edge lengths.
+  // The sum of triangle t's edge lengths (for the grid's cell size).
   auto edge_lengths = [&](size_t t) {
     const uint32_t *v = &tris[3 * t];
     double sum = 0;
