@@ -561,9 +561,10 @@ private:
           continue;
         V3 dv = cc - v3(v->point());
         float d2 = float(norm2(dv));
-        // Of Voronoi vertices equally far in single precision, the first in
-        // the order of the coordinates: the order of the cells in memory
-        // depends on the order of insertion.
+        // Of Voronoi vertices equally far in single precision, the one whose
+        // offset is the larger in lexicographic order, whichever cell comes
+        // first: the order of the cells in memory depends on the order of
+        // insertion.
         if (d2 > d.best ||
             (d2 == d.best &&
              std::tie(dv.x, dv.y, dv.z) >
