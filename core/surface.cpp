@@ -1540,6 +1540,16 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     runs[slot(grid[i].first)] = {grid[i].first, uint32_t(i), uint32_t(j)};
   }
 
+  // Calls visit(u) on each used vertex u in the grid cell of point p and in
+  // the 26 around it, in the grid's order.
+  auto for_grid_around = [&](const double *p, auto &&visit) {
+    for (int j = 0; j < 27; ++j) {
+      const Run &run = runs[slot(key(p, j / 9 - 1, j / 3 % 3 - 1, j % 3 - 1))];
+      for (uint32_t i = run.first; i < run.last; ++i)
+        visit(grid[i].second);
+    }
+  };
+
   size_t attached = 0;
   // Each split below keeps the counts of describe() up to date (one across
   // a boundary edge makes its loop an edge longer); where edges or
@@ -1593,15 +1603,11 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     // it (of equals, the first in the grid).
     double near = std::numeric_limits<double>::infinity();
     uint32_t nu = UINT32_MAX;
-    for (int j = 0; j < 27; ++j) {
-      const Run &run = runs[slot(key(p, j / 9 - 1, j / 3 % 3 - 1, j % 3 - 1))];
-      for (uint32_t i = run.first; i < run.last; ++i) {
-        const uint32_t u = grid[i].second;
-        const double d = dist2(p, xyz + 3 * size_t(u));
-        if (d < near)
-          near = d, nu = u;
-      }
-    }
+    for_grid_around(p, [&](uint32_t u) {
+      const double d = dist2(p, xyz + 3 * size_t(u));
+      if (d < near)
+        near = d, nu = u;
+    });
     if (nu == UINT32_MAX)
       continue;
     auto visit = [&](uint32_t t) {
@@ -1624,12 +1630,7 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
     // or nearer another layer of it than its own): every triangle with a
     // corner in those grid cells.
     if (bt == UINT32_MAX)
-      for (int j = 0; j < 27; ++j) {
-        const Run &run =
-            runs[slot(key(p, j / 9 - 1, j / 3 % 3 - 1, j % 3 - 1))];
-        for (uint32_t i = run.first; i < run.last; ++i)
-          for_star(grid[i].second, visit);
-      }
+      for_grid_around(p, [&](uint32_t u) { for_star(u, visit); });
     if (bt == UINT32_MAX)
       continue;
     // Split the triangle at the sample: into three when the closest point
