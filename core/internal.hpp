@@ -227,7 +227,7 @@ void pair_half_edges(size_t n, const std::vector<uint32_t> &tris,
 size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                    Progress &progress);
 // Closes every hole of at most max_loop edges by a least-area patch (a loop
-// of more than a few dozen edges is first cut by short chords into
+// of more than 16 edges is first cut by short chords into
 // pieces), except the loops that boundary (which may be empty) marks as
 // where the surface ends. The patches together take at most max_work steps
 // of the dynamic programme (about L^3 / 6 for a loop of L edges); loops

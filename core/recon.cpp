@@ -19,7 +19,7 @@ namespace {
 
 constexpr size_t kMaxPoints = 0xFFFFFFFEu;
 // The watertight closure by patches fills holes of any length: a long loop
-// is cut into pieces of a few dozen edges first (the least-area patch
+// is cut into pieces of at most 16 edges first (the least-area patch
 // costs the cube of the length) ...
 constexpr size_t kMaxFillLoop = std::numeric_limits<size_t>::max();
 // ... and all the patches together take at most this many steps of the
