@@ -162,7 +162,9 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
       }
     }
   }
-  fix_fans(n, tris, reg.in);
+  // The surface is a manifold: only where the region left triangles out
+  // can a vertex have several fans in it.
+  fix_fans(n, tris, reg.in, true);
 
   // The cuts: triangles left out, in groups that share vertices.
   std::vector<uint32_t> group(n);

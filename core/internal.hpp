@@ -210,9 +210,11 @@ void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 // A vertex whose triangles (those with in[t] set) form several fans is
 // pinched: keeps its largest fan. Removing triangles can pinch their other
 // vertices, so repeats until every vertex has one fan. Clears in[t] for the
-// triangles removed.
+// triangles removed. With one_fan_before, the triangles were one fan at
+// each vertex before in[] was cleared for some of them: only the vertices
+// of those need looking at.
 void fix_fans(size_t n, const std::vector<uint32_t> &tris,
-              std::vector<uint8_t> &in);
+              std::vector<uint8_t> &in, bool one_fan_before = false);
 // twin[h] for half-edge h = 3 t + k (from corner k of triangle t to corner
 // k + 1): the other half-edge of its edge when exactly two triangles share
 // the edge, else UINT32_MAX.

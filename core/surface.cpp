@@ -439,13 +439,15 @@ bool one_fan(uint32_t v, const std::vector<uint32_t> &star,
 }
 
 // fix_fans() over the stars ostar of the triangles (those with in[t]
-// clear are passed over, so a star of more triangles will do).
+// clear are passed over, so a star of more triangles will do), starting
+// from the vertices in work, or from every vertex when it is empty.
 void fix_fans_in(size_t n, const VertexStar &ostar,
-                 const std::vector<uint32_t> &otri, std::vector<uint8_t> &in) {
-  std::vector<uint32_t> work;
-  for (uint32_t v = 0; v < n; ++v)
-    if (ostar.first[v + 1] > ostar.first[v])
-      work.push_back(v);
+                 const std::vector<uint32_t> &otri, std::vector<uint8_t> &in,
+                 std::vector<uint32_t> work = {}) {
+  if (work.empty())
+    for (uint32_t v = 0; v < n; ++v)
+      if (ostar.first[v + 1] > ostar.first[v])
+        work.push_back(v);
   std::vector<uint32_t> cur;
   std::vector<int> fan_of;
   while (!work.empty()) {
@@ -478,10 +480,23 @@ void fix_fans_in(size_t n, const VertexStar &ostar,
 } // namespace
 
 void fix_fans(size_t n, const std::vector<uint32_t> &otri,
-              std::vector<uint8_t> &in) {
+              std::vector<uint8_t> &in, bool one_fan_before) {
+  std::vector<uint32_t> work;
+  if (one_fan_before) {
+    // Only a vertex that lost a triangle can have more than one fan now.
+    // In the order of the whole list, which decides between fans of equal
+    // size: the same result as looking at every vertex.
+    for (size_t t = 0; t < in.size(); ++t)
+      if (!in[t])
+        work.insert(work.end(), &otri[3 * t], &otri[3 * t] + 3);
+    if (work.empty())
+      return;
+    std::sort(work.begin(), work.end());
+    work.erase(std::unique(work.begin(), work.end()), work.end());
+  }
   VertexStar ostar;
   ostar.build(n, otri, [&](size_t t) { return in[t] != 0; });
-  fix_fans_in(n, ostar, otri, in);
+  fix_fans_in(n, ostar, otri, in, std::move(work));
 }
 
 namespace {
