@@ -946,6 +946,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   std::vector<uint32_t> otri(live); // oriented copy
   std::vector<uint8_t> in(nl, 0), used(et.edges(), 0);
   std::vector<int32_t> owner(n, -1);
+  std::vector<uint32_t> new_fan; // vertices that may have several fans
   // The id of the edge x-y of live triangle t.
   auto edge_of = [&](uint32_t t, uint32_t x, uint32_t y) {
     const uint64_t key = edge_key(x, y);
@@ -972,6 +973,12 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
       if (used[e[k]] & dir_bit(x, y))
         return false;
     }
+    // A corner already in the component that shares neither of its edges
+    // with a triangle of it starts a second fan there, which later
+    // triangles may or may not join to the first.
+    for (int k = 0; k < 3; ++k)
+      if (owner[v[k]] == comp && !used[e[k]] && !used[e[(k + 2) % 3]])
+        new_fan.push_back(v[k]);
     for (int k = 0; k < 3; ++k) {
       used[e[k]] |= dir_bit(v[k], v[(k + 1) % 3]);
       owner[v[k]] = comp;
@@ -1112,8 +1119,15 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     ++comps;
   }
 
-  // The stars of every live triangle, those the walk left out passed over.
-  fix_fans_in(n, star, otri, in);
+  // The stars of every live triangle, those the walk left out passed over;
+  // only where a second fan was started can a vertex have several, and the
+  // list in vertex order gives the result that looking at every vertex
+  // would.
+  if (!new_fan.empty()) {
+    std::sort(new_fan.begin(), new_fan.end());
+    new_fan.erase(std::unique(new_fan.begin(), new_fan.end()), new_fan.end());
+    fix_fans_in(n, star, otri, in, std::move(new_fan));
+  }
 
   // The output, its components (triangles sharing an edge), and their
   // topology. Closed components facing inward are flipped.
