@@ -124,11 +124,27 @@ struct EdgeTable {
                                            uint8_t(k)};
       }
     }
-    for (size_t v = 0; v < n; ++v)
-      std::sort(entries.begin() + count[v], entries.begin() + count[v + 1],
-                [](const Entry &x, const Entry &y) {
-                  return x.key != y.key ? x.key < y.key : x.tri < y.tri;
-                });
+    // A bucket holds a vertex's edges, filled in triangle order: a stable
+    // sort by key alone, which keeps that order among the triangles of an
+    // edge, sorts it by (key, triangle). Buckets are nearly always a few
+    // entries, for which an insertion sort costs least.
+    for (size_t v = 0; v < n; ++v) {
+      Entry *b = entries.data() + count[v];
+      const size_t m = count[v + 1] - count[v];
+      if (m > 32) {
+        std::stable_sort(b, b + m, [](const Entry &x, const Entry &y) {
+          return x.key < y.key;
+        });
+        continue;
+      }
+      for (size_t i = 1; i < m; ++i) {
+        const Entry x = b[i];
+        size_t j = i;
+        for (; j > 0 && b[j - 1].key > x.key; --j)
+          b[j] = b[j - 1];
+        b[j] = x;
+      }
+    }
     first.clear();
     tri_edge.assign(3 * nt, 0);
     for (size_t i = 0; i < entries.size(); ++i) {
