@@ -703,34 +703,32 @@ private:
         pole[j] = {d.pole[0], d.pole[1], d.pole[2]};
         V3 dv = cc - P[j];
         double len2 = norm2(dv), dp = dot(dv, pole[j]);
-        if (dp < 0 && float(len2) > d.h2)
-          d.h2 = float(len2);
         const double reach2 = sin2_c * len2;
         in_cone[j] = dp * dp <= reach2;
         // The growth below counts the cell as in the cocone unless it is
         // clearly outside.
         grow_cone[j] = !(dp * dp > reach2);
-        if (in_cone[j] && trusted && float(len2) > d.r2)
-          d.r2 = float(len2);
+        // As maxima with 0 (h and r start at 0): the conditions are as
+        // likely true as false, and branches on them were mispredicted.
+        const float l2 = float(len2);
+        d.h2 = std::max(d.h2, dp < 0 ? l2 : 0.0f);
+        d.r2 = std::max(d.r2, in_cone[j] && trusted ? l2 : 0.0f);
       }
       // Poles that agree, and the links the growth below may follow: bit
       // 4 j + i when the circumcentre is in j's cocone and the poles of i
       // and j agree.
       uint16_t links = 0;
+      bool disagrees[4] = {false, false, false, false};
       for (int j = 0; j < 4; ++j)
         for (int i = 0; i < j; ++i) {
-          const double agree = std::fabs(dot(pole[i], pole[j]));
-          if (agree < cos_a) {
-            if (in_cone[j])
-              c->vertex(j)->info().flags |= kVDisagree;
-            if (in_cone[i])
-              c->vertex(i)->info().flags |= kVDisagree;
-          }
-          if (agree >= cos_a) {
-            links |= uint16_t(grow_cone[j]) << (4 * j + i);
-            links |= uint16_t(grow_cone[i]) << (4 * i + j);
-          }
+          const bool agree = std::fabs(dot(pole[i], pole[j])) >= cos_a;
+          disagrees[j] |= !agree && in_cone[j];
+          disagrees[i] |= !agree && in_cone[i];
+          links |= uint16_t(agree && grow_cone[j]) << (4 * j + i);
+          links |= uint16_t(agree && grow_cone[i]) << (4 * i + j);
         }
+      for (int j = 0; j < 4; ++j)
+        c->vertex(j)->info().flags |= uint8_t(disagrees[j] ? kVDisagree : 0);
       cell_links[k - 1] = links;
     });
 
