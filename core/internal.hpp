@@ -156,6 +156,8 @@ struct EdgeTableFree {
   void operator()(EdgeTable *et) const;
 };
 typedef std::unique_ptr<EdgeTable, EdgeTableFree> EdgeTablePtr;
+// An empty table, for fill_holes() to leave the table of its result in.
+EdgeTablePtr new_edge_table();
 // Frees the arrays that this thread's edge tables and vertex stars keep
 // for reuse (surface.cpp); called at the end of each reconstruction.
 void release_scratch();
@@ -233,12 +235,14 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 // pieces), except the loops that boundary (which may be empty) marks as
 // where the surface ends. The patches together take at most max_work steps
 // of the dynamic programme (about L^3 / 6 for a loop of L edges); loops
-// beyond it stay. `table`, when given, is the edge table of tris.
+// beyond it stay. `table`, when given, is the edge table of tris, or an
+// empty table (new_edge_table()) to build it in; either way it is the table
+// of the filled tris on return, for describe(), though no longer in
+// angular order about each edge.
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                 size_t max_loop, const std::vector<uint8_t> &boundary,
                 Progress &progress, sc_diag_t &diag,
-                uint64_t max_work = UINT64_MAX,
-                const EdgeTable *table = nullptr);
+                uint64_t max_work = UINT64_MAX, EdgeTable *table = nullptr);
 
 // One reconstruction, fed all at once or in chunks.
 class Recon {

@@ -134,8 +134,10 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   // describe() runs once the holes are filled.
   auto patch = [&] {
     b.tris.swap(surf.tris);
-    fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork);
-    describe(lxyz, m, b.tris, progress, b, db);
+    EdgeTablePtr table = new_edge_table();
+    fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork,
+               table.get());
+    describe(lxyz, m, b.tris, progress, b, db, table.get());
     drop_debris(b, db);
   };
   const bool labels_first = params_.watertight_labels != 0;

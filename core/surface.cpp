@@ -222,6 +222,43 @@ struct EdgeTable {
     first.push_back(uint32_t(out));
   }
 
+  // Adds the triangles from number first_new of tris on (those before it
+  // are the table's): the table of all of tris, as build() would give it
+  // without angles but for the order of each edge's old triangles, which
+  // stay as they were, before the new ones. Merging the new triangles'
+  // sorted entries into the table, from the back and in place (no fresh
+  // memory), costs less than building the table again.
+  void append(size_t n, const std::vector<uint32_t> &tris, size_t first_new,
+              Progress &progress) {
+    const size_t nt = tris.size() / 3;
+    if (first_new >= nt)
+      return;
+    const std::vector<uint32_t> added(tris.begin() + 3 * first_new,
+                                      tris.end());
+    EdgeTable more;
+    more.build(nullptr, n, added, progress, false);
+    size_t i = entries.size(), j = more.entries.size();
+    entries.resize(i + j);
+    for (size_t out = entries.size(); j > 0; --out) {
+      // Of equal keys the new entries go last.
+      if (i > 0 && entries[i - 1].key > more.entries[j - 1].key) {
+        entries[out - 1] = entries[--i];
+      } else {
+        entries[out - 1] = more.entries[--j];
+        entries[out - 1].tri += uint32_t(first_new);
+      }
+    }
+    first.clear();
+    tri_edge.assign(3 * nt, 0);
+    for (size_t k = 0; k < entries.size(); ++k) {
+      if (k == 0 || entries[k].key != entries[k - 1].key)
+        first.push_back(uint32_t(k));
+      tri_edge[3 * size_t(entries[k].tri) + entries[k].corner] =
+          uint32_t(first.size() - 1);
+    }
+    first.push_back(uint32_t(entries.size()));
+  }
+
   // The vertex of entry x's triangle that is not on its edge.
   static uint32_t third(const std::vector<uint32_t> &tris, const Entry &x) {
     return tris[3 * size_t(x.tri) + (x.corner + 2) % 3];
@@ -267,6 +304,8 @@ struct EdgeTable {
 thread_local Pool<EdgeTable::Entry> EdgeTable::entry_pool;
 
 void EdgeTableFree::operator()(EdgeTable *et) const { delete et; }
+
+EdgeTablePtr new_edge_table() { return EdgeTablePtr(new EdgeTable); }
 
 void pair_half_edges(size_t n, const std::vector<uint32_t> &tris,
                      Progress &progress, std::vector<uint32_t> &twin) {
@@ -697,15 +736,19 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
                 size_t max_loop, const std::vector<uint8_t> &boundary,
                 Progress &progress, sc_diag_t &diag, uint64_t max_work,
-                const EdgeTable *table) {
+                EdgeTable *table) {
+  // (Built only when needed: a table takes the pools' largest arrays.)
+  std::unique_ptr<EdgeTable> own;
+  if (!table) {
+    own.reset(new EdgeTable);
+    table = own.get();
+  }
+  if (table->first.empty())
+    table->build(xyz, n, res, progress, false);
   if (res.empty())
     return;
-  EdgeTable own;
-  if (!table) {
-    own.build(xyz, n, res, progress, false);
-    table = &own;
-  }
   const EdgeTable &et = *table;
+  const size_t unfilled = res.size() / 3;
   // Each vertex's neighbours along the surface's edges ...
   std::vector<uint32_t> adj_first(n + 1, 0), adj(2 * et.edges());
   for (size_t e = 0; e < et.edges(); ++e) {
@@ -867,6 +910,9 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     ++diag.holes_filled;
     diag.hole_triangles += added;
   }
+  // The patches' triangles join the caller's table.
+  if (!own)
+    table->append(n, res, unfilled, progress);
 }
 
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
@@ -1156,12 +1202,10 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   // triangles about each edge in angular order, which none of the passes
   // below depends on).
   et.keep_live(in);
-  const size_t walked = res.size();
   if (max_hole >= 3)
     fill_holes(xyz, n, res, max_hole, boundary, progress, diag, UINT64_MAX,
                &et);
-  describe(xyz, n, res, progress, out, diag,
-           res.size() == walked ? &et : nullptr);
+  describe(xyz, n, res, progress, out, diag, &et);
 }
 
 void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
