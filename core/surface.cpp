@@ -495,14 +495,14 @@ bool one_fan(uint32_t v, const std::vector<uint32_t> &star,
 
 // fix_fans() over the stars ostar of the triangles (those with in[t]
 // clear are passed over, so a star of more triangles will do), starting
-// from the vertices in work, or from every vertex when it is empty.
-void fix_fans_in(size_t n, const VertexStar &ostar,
-                 const std::vector<uint32_t> &otri, std::vector<uint8_t> &in,
-                 std::vector<uint32_t> work = {}) {
-  if (work.empty())
-    for (uint32_t v = 0; v < n; ++v)
-      if (ostar.first[v + 1] > ostar.first[v])
-        work.push_back(v);
+// from the vertices in work (any order, repeats allowed): every vertex that
+// may have several fans. They are taken in vertex order, which decides
+// between fans of equal size, so any list that holds those vertices gives
+// the result of looking at every vertex.
+void fix_fans_in(const VertexStar &ostar, const std::vector<uint32_t> &otri,
+                 std::vector<uint8_t> &in, std::vector<uint32_t> work) {
+  std::sort(work.begin(), work.end()); // popped from the back
+  work.erase(std::unique(work.begin(), work.end()), work.end());
   std::vector<uint32_t> cur;
   std::vector<int> fan_of;
   while (!work.empty()) {
@@ -539,19 +539,19 @@ void fix_fans(size_t n, const std::vector<uint32_t> &otri,
   std::vector<uint32_t> work;
   if (one_fan_before) {
     // Only a vertex that lost a triangle can have more than one fan now.
-    // In the order of the whole list, which decides between fans of equal
-    // size: the same result as looking at every vertex.
     for (size_t t = 0; t < in.size(); ++t)
       if (!in[t])
         work.insert(work.end(), &otri[3 * t], &otri[3 * t] + 3);
     if (work.empty())
       return;
-    std::sort(work.begin(), work.end());
-    work.erase(std::unique(work.begin(), work.end()), work.end());
   }
   VertexStar ostar;
   ostar.build(n, otri, [&](size_t t) { return in[t] != 0; });
-  fix_fans_in(n, ostar, otri, in, std::move(work));
+  if (!one_fan_before)
+    for (uint32_t v = 0; v < n; ++v)
+      if (ostar.first[v + 1] > ostar.first[v])
+        work.push_back(v);
+  fix_fans_in(ostar, otri, in, std::move(work));
 }
 
 namespace {
@@ -1182,14 +1182,8 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   }
 
   // The stars of every live triangle, those the walk left out passed over;
-  // only where a second fan was started can a vertex have several, and the
-  // list in vertex order gives the result that looking at every vertex
-  // would.
-  if (!new_fan.empty()) {
-    std::sort(new_fan.begin(), new_fan.end());
-    new_fan.erase(std::unique(new_fan.begin(), new_fan.end()), new_fan.end());
-    fix_fans_in(n, star, otri, in, std::move(new_fan));
-  }
+  // only where a second fan was started can a vertex have several.
+  fix_fans_in(star, otri, in, std::move(new_fan));
 
   // The output, its components (triangles sharing an edge), and their
   // topology. Closed components facing inward are flipped.
