@@ -124,7 +124,17 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   sc_diag_t db = diag;
   // Handles that closed round a hole, where the scan has no samples, would
   // stay in any closure: cut them first (see cut_handles()).
-  const uint64_t handles = cut ? cut_handles(lxyz, m, open, progress) : 0;
+  // A handle is genus: where every open component is a disc with holes
+  // (genus 0, every edge and vertex manifold), the region grown over it
+  // takes every triangle, and there is nothing to cut.
+  bool any_genus = surf.pinched != 0;
+  for (const Surface::Part &p : surf.parts)
+    if (p.boundary_edges > 0 &&
+        (p.nonmanifold_edges > 0 ||
+         2 - (p.vertices - p.edges + p.faces) != int64_t(p.loops)))
+      any_genus = true;
+  const uint64_t handles =
+      cut && any_genus ? cut_handles(lxyz, m, open, progress) : 0;
   if (handles) {
     surf.tris = open;
     surf.tris.insert(surf.tris.end(), closed_part.begin(), closed_part.end());
