@@ -235,31 +235,31 @@ inline int cone_side(V3 dir, V3 pole_unit, double sin2_cocone) {
 // The candidate test for triangle abc with indices idx. The dual Voronoi
 // edge runs from v1 to v2, or from v1 along direction v2 when `ray`.
 // interior says which vertices the cocone test is made at: all three except
-// in boundary mode, and at least one.
+// in boundary mode, and at least one. In cocone mode side1[k] is
+// cone_side(v1 - P[k], poles[k]) for the interior vertices: the same for
+// every facet of v1's cell at that vertex, so it is computed once a cell.
 bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles,
-                  const bool *interior, V3 v1, V3 v2, bool ray) {
-  V3 n = cross(P[1] - P[0], P[2] - P[0]);
-  double n2 = norm2(n);
-  if (!(n2 > 0))
-    return false;
-
+                  const bool *interior, const int *side1, V3 v1, V3 v2,
+                  bool ray) {
   if (cr.mode == SC_MODE_COCONE) {
     if (!interior[0] && !interior[1] && !interior[2])
       return false;
     for (int k = 0; k < 3; ++k) {
-      if (!interior[k])
+      if (!interior[k] || side1[k] == 0)
         continue;
-      const V3 &pole = poles[k];
-      int s1 = cone_side(v1 - P[k], pole, cr.sin2_cocone);
-      if (s1 == 0)
-        continue;
-      int s2 = cone_side(ray ? v2 : v2 - P[k], pole, cr.sin2_cocone);
-      if (s2 == 0 || s2 != s1)
+      int s2 = cone_side(ray ? v2 : v2 - P[k], poles[k], cr.sin2_cocone);
+      if (s2 == 0 || s2 != side1[k])
         continue;
       return false;
     }
-    return true;
+    // A degenerate triangle never is (tested last: most facets fail the
+    // cocone test).
+    return norm2(cross(P[1] - P[0], P[2] - P[0])) > 0;
   }
+  V3 n = cross(P[1] - P[0], P[2] - P[0]);
+  double n2 = norm2(n);
+  if (!(n2 > 0))
+    return false;
   n = (1 / std::sqrt(n2)) * n;
 
   // Criterion 1: the normal at the vertex with the largest angle, which is
@@ -1194,7 +1194,9 @@ private:
     size_t cells = dt_.number_of_cells(), k = 0;
     V3 P[3], poles[3], CP[4], Cpoles[4];
     bool interior[3] = {true, true, true}, Cinterior[4];
+    int side1[3] = {0, 0, 0}, Cside[4] = {0, 0, 0, 0};
     uint32_t idx[3], Cidx[4];
+    const bool cocone = cr.mode == SC_MODE_COCONE;
     const Vh inf = dt_.infinite_vertex();
     for_cells(true, [&](auto c) {
       progress.tick(k++, cells);
@@ -1218,6 +1220,8 @@ private:
             Cpoles[j] = {d.pole[0], d.pole[1], d.pole[2]};
             Cidx[j] = d.idx;
             Cinterior[j] = !detect || (d.flags & kVInterior) != 0;
+            if (cocone && Cinterior[j])
+              Cside[j] = cone_side(cc - CP[j], Cpoles[j], cr.sin2_cocone);
           }
           loaded = true;
         }
@@ -1227,6 +1231,7 @@ private:
           poles[j] = Cpoles[i];
           idx[j] = Cidx[i];
           interior[j] = Cinterior[i];
+          side1[j] = Cside[i];
         }
         V3 other;
         if (ray) {
@@ -1238,7 +1243,7 @@ private:
           const float *oc = nb->info().cc;
           other = {oc[0], oc[1], oc[2]};
         }
-        if (is_candidate(cr, P, poles, interior, cc, other, ray)) {
+        if (is_candidate(cr, P, poles, interior, side1, cc, other, ray)) {
           tris.push_back(idx[0]);
           tris.push_back(idx[1]);
           tris.push_back(idx[2]);
