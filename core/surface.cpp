@@ -70,7 +70,7 @@ thread_local Pool<uint32_t> u32_pool;
 struct EdgeTable {
   struct Entry {
     uint64_t key;
-    double angle; // about the edge, from a reference direction (build())
+    double angle; // about the edge, in quarter turns (Frame::quarters())
     uint32_t tri;
     uint8_t corner; // the edge is (v[corner], v[corner + 1]) of tri
     // Left uninitialised: build() writes every entry of a table sized up
@@ -99,9 +99,9 @@ struct EdgeTable {
 
   // Without `angles`, the triangles of an edge come in the order of their
   // numbers and Entry::angle is 0: enough for finding edges and their
-  // triangles, and it saves an atan2 per corner. (With them, an edge of a
+  // triangles, and it saves a frame per edge. (With them, an edge of a
   // single triangle has angle 0 too, for nothing compares it, and an edge
-  // of two has angles 0 and 0 or pi: see below.)
+  // of two has angles 0 and 0 or 2 quarters: see below.)
   void build(const double *xyz, size_t n, const std::vector<uint32_t> &tris,
              Progress &progress, bool angles = true) {
     const size_t nt = tris.size() / 3;
@@ -167,7 +167,7 @@ struct EdgeTable {
         // Two triangles are in either order about their edge, and all
         // that is asked of their angles is whether they are less than a
         // right angle apart (is_sharp()): angles 0 and 0 if they are, 0
-        // and pi if not. The sign of the dot product of the two
+        // and a half turn if not. The sign of the dot product of the two
         // triangles' directions across the edge tells, without an atan2.
         const double *a = xyz + 3 * size_t(key_lo(x->key)),
                      *b = xyz + 3 * size_t(uint32_t(x->key));
@@ -179,12 +179,12 @@ struct EdgeTable {
         const double across =
             dot3(w1, w2) * dot3(u, u) - dot3(w1, u) * dot3(w2, u);
         x[0].angle = 0;
-        x[1].angle = across > 0 ? 0.0 : M_PI;
+        x[1].angle = across > 0 ? 0.0 : 2.0;
         continue;
       }
       const Frame f(xyz, key_lo(x->key), uint32_t(x->key));
       for (uint32_t i = 0; i < k; ++i)
-        x[i].angle = f.angle(xyz, third(tris, x[i]));
+        x[i].angle = f.quarters(xyz, third(tris, x[i]));
       for (uint32_t i = 1; i < k; ++i)
         for (uint32_t j = i; j > 0 && (x[j].angle < x[j - 1].angle ||
                                        (x[j].angle == x[j - 1].angle &&
@@ -292,11 +292,23 @@ struct EdgeTable {
       e2[1] = u[2] * e1[0] - u[0] * e1[2];
       e2[2] = u[0] * e1[1] - u[1] * e1[0];
     }
-    // The angle of the half-plane that contains point c.
-    double angle(const double *xyz, uint32_t c) const {
+    // The angle of the half-plane that contains point c, in quarter
+    // turns: -2 to 2 as atan2 goes from -pi to pi, for a division instead
+    // of an atan2. Within each quarter it is the fraction that one
+    // coordinate is of the sum of their sizes, which grows with the angle,
+    // and a direction turned by a quarter gets exactly 1 more; so quarters
+    // order half-planes as angles do, and a gap of more than three quarters
+    // is one of more than three right angles (but for rounding, which
+    // moves either test only at a gap of exactly three right angles).
+    double quarters(const double *xyz, uint32_t c) const {
       const double *p = xyz + 3 * size_t(c);
       double w[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
-      return std::atan2(dot3(w, e2), dot3(w, e1));
+      const double x = dot3(w, e1), y = dot3(w, e2);
+      if (x == 0 && y == 0)
+        return 0; // c on the edge's line: no candidate is that degenerate
+      if (!std::signbit(y))
+        return x >= 0 ? y / (x + y) : 1 + -x / (y - x);
+      return x < 0 ? -2 + -y / (-x - y) : -1 + x / (x - y);
     }
   };
 };
@@ -352,8 +364,9 @@ bool is_sharp(const EdgeTable &et, uint32_t e,
     return false;
   if (k == 1)
     return erode_single;
-  gap = std::max(gap, 2 * M_PI - (prev - first));
-  return gap > 1.5 * M_PI;
+  // In quarter turns: more than three right angles.
+  gap = std::max(gap, 4 - (prev - first));
+  return gap > 3;
 }
 
 struct UnionFind {
