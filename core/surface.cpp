@@ -145,16 +145,7 @@ struct EdgeTable {
         b[j] = x;
       }
     }
-    first.clear();
-    tri_edge.assign(3 * nt, 0);
-    for (size_t i = 0; i < entries.size(); ++i) {
-      progress.tick(nt + i / 3, 2 * nt);
-      if (i == 0 || entries[i].key != entries[i - 1].key)
-        first.push_back(uint32_t(i));
-      tri_edge[3 * size_t(entries[i].tri) + entries[i].corner] =
-          uint32_t(first.size() - 1);
-    }
-    first.push_back(uint32_t(entries.size()));
+    index_edges(nt, &progress);
     if (!angles)
       return;
     // Each edge's frame once, then its triangles by angle (ties by number).
@@ -248,12 +239,20 @@ struct EdgeTable {
         entries[out - 1].tri += uint32_t(first_new);
       }
     }
+    index_edges(nt, nullptr);
+  }
+
+  // first and tri_edge from the entries, sorted by key, of nt triangles
+  // (ticking the second half of build()'s progress when given).
+  void index_edges(size_t nt, Progress *progress) {
     first.clear();
     tri_edge.assign(3 * nt, 0);
-    for (size_t k = 0; k < entries.size(); ++k) {
-      if (k == 0 || entries[k].key != entries[k - 1].key)
-        first.push_back(uint32_t(k));
-      tri_edge[3 * size_t(entries[k].tri) + entries[k].corner] =
+    for (size_t i = 0; i < entries.size(); ++i) {
+      if (progress)
+        progress->tick(nt + i / 3, 2 * nt);
+      if (i == 0 || entries[i].key != entries[i - 1].key)
+        first.push_back(uint32_t(i));
+      tri_edge[3 * size_t(entries[i].tri) + entries[i].corner] =
           uint32_t(first.size() - 1);
     }
     first.push_back(uint32_t(entries.size()));
