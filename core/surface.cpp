@@ -1602,52 +1602,83 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
   if (!(cell > 0))
     return 0;
   // A hash grid of the used vertices, cells twice the mean edge long.
-  auto key = [&](const double *p, int dx, int dy, int dz) {
-    int64_t x = int64_t(std::floor(p[0] / cell)) + dx,
-            y = int64_t(std::floor(p[1] / cell)) + dy,
-            z = int64_t(std::floor(p[2] / cell)) + dz;
-    return uint64_t(x * 73856093) ^ uint64_t(y * 19349663) ^
-           uint64_t(z * 83492791);
+  struct CellXyz {
+    int64_t x, y, z;
   };
-  std::vector<std::pair<uint64_t, uint32_t>> grid;
-  for (uint32_t v = 0; v < n; ++v)
-    if (used[v])
-      grid.emplace_back(key(xyz + 3 * size_t(v), 0, 0, 0), v);
-  std::sort(grid.begin(), grid.end());
-  // Where each cell's run of the grid is, in a flat table with linear
-  // probing: one lookup per cell looked at, which mostly finds the slot the
-  // previous sample found (a node-based map cost a cache miss each time).
+  auto cell_of = [&](const double *p) {
+    return CellXyz{int64_t(std::floor(p[0] / cell)),
+                   int64_t(std::floor(p[1] / cell)),
+                   int64_t(std::floor(p[2] / cell))};
+  };
+  auto key = [](const CellXyz &c) {
+    return uint64_t(c.x * 73856093) ^ uint64_t(c.y * 19349663) ^
+           uint64_t(c.z * 83492791);
+  };
+  // Each key's run of the grid (its vertices in increasing order), found
+  // in a flat table with linear probing: one lookup per cell looked at,
+  // which mostly finds the slot the previous sample found (a node-based
+  // map cost a cache miss each time). The table doubles as keys arrive, so
+  // that it stays at most half full; the runs are laid out by a counting
+  // pass over it, not a sort.
   struct Run {
     uint64_t key;
     uint32_t first, last; // last == 0: an empty slot
   };
-  size_t occupied = 0;
-  for (size_t i = 0; i < grid.size(); ++i)
-    occupied += i == 0 || grid[i].first != grid[i - 1].first;
-  size_t slots = 16;
-  while (slots < 2 * occupied)
-    slots *= 2;
-  std::vector<Run> runs(slots, Run{0, 0, 0});
-  const size_t mask = slots - 1;
+  std::vector<Run> runs(16, Run{0, 0, 0});
+  size_t mask = runs.size() - 1, occupied = 0;
   auto slot = [&](uint64_t k) {
     size_t h = size_t((k * 0x9E3779B97F4A7C15ull) >> 32) & mask;
     while (runs[h].last != 0 && runs[h].key != k)
       h = (h + 1) & mask;
     return h;
   };
-  for (size_t i = 0, j; i < grid.size(); i = j) {
-    for (j = i + 1; j < grid.size() && grid[j].first == grid[i].first; ++j) {
+  std::vector<uint64_t> vkey;
+  for (uint32_t v = 0; v < n; ++v) {
+    if (!used[v])
+      continue;
+    const uint64_t k = key(cell_of(xyz + 3 * size_t(v)));
+    vkey.push_back(k);
+    Run &r = runs[slot(k)];
+    if (r.last != 0) {
+      ++r.last; // the run's length, until the layout below
+      continue;
     }
-    runs[slot(grid[i].first)] = {grid[i].first, uint32_t(i), uint32_t(j)};
+    r = Run{k, 0, 1};
+    if (2 * ++occupied > runs.size()) {
+      std::vector<Run> old(2 * runs.size(), Run{0, 0, 0});
+      old.swap(runs);
+      mask = runs.size() - 1;
+      for (const Run &o : old)
+        if (o.last != 0)
+          runs[slot(o.key)] = o;
+    }
   }
+  std::vector<uint32_t> grid(vkey.size());
+  {
+    std::vector<uint32_t> fill(runs.size());
+    uint32_t at = 0;
+    for (size_t h = 0; h < runs.size(); ++h)
+      if (runs[h].last != 0) {
+        fill[h] = runs[h].first = at;
+        at += runs[h].last;
+        runs[h].last = at;
+      }
+    size_t i = 0;
+    for (uint32_t v = 0; v < n; ++v)
+      if (used[v])
+        grid[fill[slot(vkey[i++])]++] = v;
+  }
+  vkey = std::vector<uint64_t>();
 
   // Calls visit(u) on each used vertex u in the grid cell of point p and in
   // the 26 around it, in the grid's order.
   auto for_grid_around = [&](const double *p, auto &&visit) {
+    const CellXyz c = cell_of(p);
     for (int j = 0; j < 27; ++j) {
-      const Run &run = runs[slot(key(p, j / 9 - 1, j / 3 % 3 - 1, j % 3 - 1))];
+      const Run &run = runs[slot(
+          key({c.x + j / 9 - 1, c.y + j / 3 % 3 - 1, c.z + j % 3 - 1}))];
       for (uint32_t i = run.first; i < run.last; ++i)
-        visit(grid[i].second);
+        visit(grid[i]);
     }
   };
 
