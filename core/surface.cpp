@@ -70,18 +70,20 @@ thread_local Pool<uint32_t> u32_pool;
 struct EdgeTable {
   struct Entry {
     uint64_t key;
-    double angle; // about the edge, in quarter turns (Frame::quarters())
     uint32_t tri;
     uint8_t corner; // the edge is (v[corner], v[corner + 1]) of tri
     // Left uninitialised: build() writes every entry of a table sized up
     // front, and zeroing it first was a pass over memory of its own.
     Entry() {}
-    Entry(uint64_t k, double a, uint32_t t, uint8_t c)
-        : key(k), angle(a), tri(t), corner(c) {}
+    Entry(uint64_t k, uint32_t t, uint8_t c) : key(k), tri(t), corner(c) {}
   };
   std::vector<Entry> entries;   // grouped by edge, each group by angle
   std::vector<uint32_t> first;  // edge id -> first entry; one extra at end
   std::vector<uint32_t> tri_edge; // 3 per triangle: edge (v[k], v[k+1])
+  // Per entry, its triangle's angle about the edge in quarter turns
+  // (Frame::quarters()), from build() with angles until keep_live(): only
+  // pruning compares angles, and the passes after it read 16-byte entries.
+  std::vector<double> angle;
 
   static thread_local Pool<Entry> entry_pool;
   EdgeTable()
@@ -98,7 +100,7 @@ struct EdgeTable {
   size_t edges() const { return first.size() - 1; }
 
   // Without `angles`, the triangles of an edge come in the order of their
-  // numbers and Entry::angle is 0: enough for finding edges and their
+  // numbers and `angle` is empty: enough for finding edges and their
   // triangles, and it saves a frame per edge. (With them, an edge of a
   // single triangle has angle 0 too, for nothing compares it, and an edge
   // of two has angles 0 and 0 or 2 quarters: see below.)
@@ -120,7 +122,7 @@ struct EdgeTable {
       progress.tick(t, 2 * nt);
       for (int k = 0; k < 3; ++k) {
         uint32_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3];
-        entries[fill[std::min(a, b)]++] = {edge_key(a, b), 0.0, uint32_t(t),
+        entries[fill[std::min(a, b)]++] = {edge_key(a, b), uint32_t(t),
                                            uint8_t(k)};
       }
     }
@@ -146,14 +148,19 @@ struct EdgeTable {
       }
     }
     index_edges(nt, &progress);
+    angle.clear();
     if (!angles)
       return;
+    angle.resize(entries.size());
     // Each edge's frame once, then its triangles by angle (ties by number).
     for (size_t e = 0; e + 1 < first.size(); ++e) {
       Entry *x = &entries[first[e]];
+      double *ang = &angle[first[e]];
       const uint32_t k = first[e + 1] - first[e];
-      if (k < 2)
+      if (k < 2) {
+        ang[0] = 0;
         continue;
+      }
       if (k == 2) {
         // Two triangles are in either order about their edge, and all
         // that is asked of their angles is whether they are less than a
@@ -169,26 +176,30 @@ struct EdgeTable {
           u[j] = b[j] - a[j], w1[j] = p[j] - a[j], w2[j] = q[j] - a[j];
         const double across =
             dot3(w1, w2) * dot3(u, u) - dot3(w1, u) * dot3(w2, u);
-        x[0].angle = 0;
-        x[1].angle = across > 0 ? 0.0 : 2.0;
+        ang[0] = 0;
+        ang[1] = across > 0 ? 0.0 : 2.0;
         continue;
       }
       const Frame f(xyz, key_lo(x->key), uint32_t(x->key));
       for (uint32_t i = 0; i < k; ++i)
-        x[i].angle = f.quarters(xyz, third(tris, x[i]));
+        ang[i] = f.quarters(xyz, third(tris, x[i]));
       for (uint32_t i = 1; i < k; ++i)
-        for (uint32_t j = i; j > 0 && (x[j].angle < x[j - 1].angle ||
-                                       (x[j].angle == x[j - 1].angle &&
-                                        x[j].tri < x[j - 1].tri));
-             --j)
+        for (uint32_t j = i;
+             j > 0 && (ang[j] < ang[j - 1] ||
+                       (ang[j] == ang[j - 1] && x[j].tri < x[j - 1].tri));
+             --j) {
           std::swap(x[j], x[j - 1]);
+          std::swap(ang[j], ang[j - 1]);
+        }
     }
   }
 
   // Keeps only the entries of triangles with alive[t] set, renumbered in
   // order (the k-th live triangle becomes k): the table that build() would
   // give for the live triangles alone, without sorting or angles again.
+  // The angles go: the order of each edge's triangles stays.
   void keep_live(const std::vector<uint8_t> &alive) {
+    angle = std::vector<double>();
     std::vector<uint32_t> renum(alive.size());
     uint32_t nl = 0;
     for (size_t t = 0; t < alive.size(); ++t)
@@ -201,7 +212,7 @@ struct EdgeTable {
         const Entry &x = entries[i];
         if (!alive[x.tri])
           continue;
-        entries[out] = {x.key, x.angle, renum[x.tri], x.corner};
+        entries[out] = {x.key, renum[x.tri], x.corner};
         tri_edge[3 * size_t(entries[out].tri) + x.corner] = uint32_t(edges);
         ++out;
       }
@@ -224,6 +235,7 @@ struct EdgeTable {
     const size_t nt = tris.size() / 3;
     if (first_new >= nt)
       return;
+    angle = std::vector<double>();
     const std::vector<uint32_t> added(tris.begin() + 3 * first_new,
                                       tris.end());
     EdgeTable more;
@@ -351,7 +363,7 @@ bool is_sharp(const EdgeTable &et, uint32_t e,
   for (uint32_t i = et.first[e]; i < et.first[e + 1]; ++i) {
     if (!alive[et.entries[i].tri])
       continue;
-    double a = et.entries[i].angle;
+    double a = et.angle[i];
     if (k == 0)
       first = a;
     else
