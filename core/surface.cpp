@@ -79,7 +79,11 @@ struct EdgeTable {
   };
   std::vector<Entry> entries;   // grouped by edge, each group by angle
   std::vector<uint32_t> first;  // edge id -> first entry; one extra at end
-  std::vector<uint32_t> tri_edge; // 3 per triangle: edge (v[k], v[k+1])
+  // 3 per triangle: edge (v[k], v[k+1]). Only pruning and the walk find
+  // edges by triangle: tables built without angles, or appended to, leave
+  // it empty, and so does keep_live() unless asked (filling it was a
+  // scattered write per entry).
+  std::vector<uint32_t> tri_edge;
   // Per entry, its triangle's angle about the edge in quarter turns
   // (Frame::quarters()), from build() with angles until keep_live(): only
   // pruning compares angles, and the passes after it read 16-byte entries.
@@ -100,8 +104,8 @@ struct EdgeTable {
   size_t edges() const { return first.size() - 1; }
 
   // Without `angles`, the triangles of an edge come in the order of their
-  // numbers and `angle` is empty: enough for finding edges and their
-  // triangles, and it saves a frame per edge. (With them, an edge of a
+  // numbers, and `angle` and tri_edge are empty: enough for finding edges
+  // and their triangles, and it saves a frame per edge. (With them, an edge of a
   // single triangle has angle 0 too, for nothing compares it, and an edge
   // of two has angles 0 and 0 or 2 quarters: see below.)
   void build(const double *xyz, size_t n, const std::vector<uint32_t> &tris,
@@ -147,7 +151,7 @@ struct EdgeTable {
         b[j] = x;
       }
     }
-    index_edges(nt, &progress);
+    index_edges(nt, &progress, angles);
     angle.clear();
     if (!angles)
       return;
@@ -198,13 +202,13 @@ struct EdgeTable {
   // order (the k-th live triangle becomes k): the table that build() would
   // give for the live triangles alone, without sorting or angles again.
   // The angles go: the order of each edge's triangles stays.
-  void keep_live(const std::vector<uint8_t> &alive) {
+  void keep_live(const std::vector<uint8_t> &alive, bool with_tri_edge) {
     angle = std::vector<double>();
     std::vector<uint32_t> renum(alive.size());
     uint32_t nl = 0;
     for (size_t t = 0; t < alive.size(); ++t)
       renum[t] = alive[t] ? nl++ : UINT32_MAX;
-    tri_edge.assign(3 * size_t(nl), 0);
+    tri_edge.assign(with_tri_edge ? 3 * size_t(nl) : 0, 0);
     size_t out = 0, edges = 0;
     for (size_t e = 0; e + 1 < first.size(); ++e) {
       const size_t start = out;
@@ -213,7 +217,8 @@ struct EdgeTable {
         if (!alive[x.tri])
           continue;
         entries[out] = {x.key, renum[x.tri], x.corner};
-        tri_edge[3 * size_t(entries[out].tri) + x.corner] = uint32_t(edges);
+        if (with_tri_edge)
+          tri_edge[3 * size_t(entries[out].tri) + x.corner] = uint32_t(edges);
         ++out;
       }
       if (out > start)
@@ -251,21 +256,22 @@ struct EdgeTable {
         entries[out - 1].tri += uint32_t(first_new);
       }
     }
-    index_edges(nt, nullptr);
+    index_edges(nt, nullptr, false);
   }
 
-  // first and tri_edge from the entries, sorted by key, of nt triangles
-  // (ticking the second half of build()'s progress when given).
-  void index_edges(size_t nt, Progress *progress) {
+  // first, and tri_edge if asked, from the entries, sorted by key, of nt
+  // triangles (ticking the second half of build()'s progress when given).
+  void index_edges(size_t nt, Progress *progress, bool with_tri_edge) {
     first.clear();
-    tri_edge.assign(3 * nt, 0);
+    tri_edge.assign(with_tri_edge ? 3 * nt : 0, 0);
     for (size_t i = 0; i < entries.size(); ++i) {
       if (progress)
         progress->tick(nt + i / 3, 2 * nt);
       if (i == 0 || entries[i].key != entries[i - 1].key)
         first.push_back(uint32_t(i));
-      tri_edge[3 * size_t(entries[i].tri) + entries[i].corner] =
-          uint32_t(first.size() - 1);
+      if (with_tri_edge)
+        tri_edge[3 * size_t(entries[i].tri) + entries[i].corner] =
+            uint32_t(first.size() - 1);
     }
     first.push_back(uint32_t(entries.size()));
   }
@@ -1020,7 +1026,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
       live.insert(live.end(), &cand[3 * t], &cand[3 * t] + 3);
   const size_t nl = live.size() / 3;
   EdgeTable &et = *table;
-  et.keep_live(alive);
+  et.keep_live(alive, true); // the walk finds edges by triangle
   VertexStar star;
   star.build(n, live, [](size_t) { return true; });
 
@@ -1219,7 +1225,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   // The candidates' table, cut down to the output: the table of res (its
   // triangles about each edge in angular order, which none of the passes
   // below depends on).
-  et.keep_live(in);
+  et.keep_live(in, false);
   if (max_hole >= 3)
     fill_holes(xyz, n, res, max_hole, boundary, progress, diag, UINT64_MAX,
                &et);
