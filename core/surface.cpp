@@ -740,19 +740,16 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
   }
   if (!(best < std::numeric_limits<double>::infinity()))
     return false;
-  std::vector<uint32_t> a, b;
-  for (size_t k = bi;; k = (k + 1) % L) {
-    a.push_back(loop[k]);
-    if (k == bj)
-      break;
-  }
-  for (size_t k = bj;; k = (k + 1) % L) {
-    b.push_back(loop[k]);
-    if (k == bi)
-      break;
-  }
+  // Each part, from one end of the chord round to the other.
+  auto part = [&](size_t from, size_t to, std::vector<uint32_t> &out) {
+    out.resize((to + L - from) % L + 1);
+    for (size_t k = 0; k < out.size(); ++k)
+      out[k] = loop[(from + k) % L];
+  };
+  std::vector<uint32_t> a;
+  part(bi, bj, a);
+  part(bj, bi, rest);
   loop.swap(a);
-  rest.swap(b);
   return true;
 }
 
