@@ -38,9 +38,10 @@ struct Region {
   std::vector<uint32_t> twin; // the other side's half-edge, or kNone
   std::vector<uint8_t> in;    // triangle is in the region
 
-  Region(size_t n, const std::vector<uint32_t> &t, Progress &progress)
+  Region(size_t n, const std::vector<uint32_t> &t, Progress &progress,
+         EdgeTable &table)
       : in(t.size() / 3, 0) {
-    pair_half_edges(n, t, progress, twin);
+    pair_half_edges(n, t, progress, twin, table);
   }
 
   bool in_region(uint32_t h) const { return h != kNone && in[h / 3]; }
@@ -102,11 +103,11 @@ struct Region {
 } // namespace
 
 size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
-                   Progress &progress) {
+                   Progress &progress, EdgeTable &table) {
   const size_t nt = tris.size() / 3;
   if (nt == 0)
     return 0;
-  Region reg(n, tris, progress);
+  Region reg(n, tris, progress, table);
   std::vector<double> centre(3 * nt);
   for (size_t t = 0; t < nt; ++t)
     for (int j = 0; j < 3; ++j)
@@ -237,17 +238,24 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   size_t cuts = 0;
   std::vector<uint32_t> kept;
   kept.reserve(tris.size());
+  std::vector<uint8_t> keep(nt, 1);
   for (size_t t = 0; t < nt; ++t) {
     const uint32_t c = find(tris[3 * t]);
     if (reg.in[t] || cut_edges[c] > kMaxCutPerHoleEdge * hole_edges[c] ||
         longest_hole[c] < kMinHolePerCutEdge * cut_edges[c]) {
       kept.insert(kept.end(), &tris[3 * t], &tris[3 * t] + 3);
-    } else if (!counted[c]) {
+      continue;
+    }
+    keep[t] = 0;
+    if (!counted[c]) {
       counted[c] = 1;
       ++cuts;
     }
   }
   tris.swap(kept);
+  // The table that pairing the half-edges built, cut down to the result.
+  if (tris.size() < 3 * nt)
+    keep_edges_of(table, keep);
   return cuts;
 }
 

@@ -219,17 +219,25 @@ void fix_fans(size_t n, const std::vector<uint32_t> &tris,
               std::vector<uint8_t> &in, bool one_fan_before = false);
 // twin[h] for half-edge h = 3 t + k (from corner k of triangle t to corner
 // k + 1): the other half-edge of its edge when exactly two triangles share
-// the edge, else UINT32_MAX.
+// the edge, else UINT32_MAX; leaves the edge table of tris in et.
 void pair_half_edges(size_t n, const std::vector<uint32_t> &tris,
-                     Progress &progress, std::vector<uint32_t> &twin);
+                     Progress &progress, std::vector<uint32_t> &twin,
+                     EdgeTable &et);
+// The edge table of the triangles that keep marks, renumbered in order.
+void keep_edges_of(EdgeTable &et, const std::vector<uint8_t> &keep);
+// The edge table of tris, from that of tris up to triangle first_new.
+void append_edges_of(EdgeTable &et, size_t n,
+                     const std::vector<uint32_t> &tris, size_t first_new,
+                     Progress &progress);
 // Cuts the handles of an oriented, edge- and vertex-manifold surface that
 // closed round a hole: grows a region over each component, nearest triangle
 // first, refusing every triangle that would join two of its boundary loops
 // (raise its genus), then takes out the refused triangles of each cut that
 // runs mostly along holes and keeps the others. The result is a manifold
-// again; returns the number of cuts.
+// again; returns the number of cuts. Leaves the edge table of the result
+// (as fill_holes() builds it) in `table`.
 size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
-                   Progress &progress);
+                   Progress &progress, EdgeTable &table);
 // Closes every hole of at most max_loop edges by a least-area patch (a loop
 // of more than 16 edges is first cut by short chords into
 // pieces), except the loops that boundary (which may be empty) marks as

@@ -133,21 +133,27 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
         (p.nonmanifold_edges > 0 ||
          2 - (p.vertices - p.edges + p.faces) != int64_t(p.loops)))
       any_genus = true;
+  // The cut leaves the edge table of the open components, which the
+  // closed ones join: the table that the patches below would build.
+  EdgeTablePtr table = new_edge_table();
   const uint64_t handles =
-      cut && any_genus ? cut_handles(lxyz, m, open, progress) : 0;
+      cut && any_genus ? cut_handles(lxyz, m, open, progress, *table) : 0;
   if (handles) {
     surf.tris = open;
     surf.tris.insert(surf.tris.end(), closed_part.begin(), closed_part.end());
+    append_edges_of(*table, m, surf.tris, open.size() / 3, progress);
+  } else {
+    table = new_edge_table(); // surf.tris as it was: the patches build it
   }
   // The surface was described after extraction, and cutting handles only
   // takes triangles out of open components: no component to flip, and
   // describe() runs once the holes are filled.
   auto patch = [&] {
     b.tris.swap(surf.tris);
-    EdgeTablePtr table = new_edge_table();
     fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork,
                table.get());
     describe(lxyz, m, b.tris, progress, b, db, table.get());
+    table.reset(); // before the labelling's triangulation, if it comes
     drop_debris(b, db);
   };
   const bool labels_first = params_.watertight_labels != 0;

@@ -337,8 +337,8 @@ void EdgeTableFree::operator()(EdgeTable *et) const { delete et; }
 EdgeTablePtr new_edge_table() { return EdgeTablePtr(new EdgeTable); }
 
 void pair_half_edges(size_t n, const std::vector<uint32_t> &tris,
-                     Progress &progress, std::vector<uint32_t> &twin) {
-  EdgeTable et;
+                     Progress &progress, std::vector<uint32_t> &twin,
+                     EdgeTable &et) {
   et.build(nullptr, n, tris, progress, false);
   twin.assign(tris.size(), UINT32_MAX);
   for (size_t e = 0; e < et.edges(); ++e) {
@@ -350,6 +350,16 @@ void pair_half_edges(size_t n, const std::vector<uint32_t> &tris,
     twin[ha] = hb;
     twin[hb] = ha;
   }
+}
+
+void keep_edges_of(EdgeTable &et, const std::vector<uint8_t> &keep) {
+  et.keep_live(keep, false);
+}
+
+void append_edges_of(EdgeTable &et, size_t n,
+                     const std::vector<uint32_t> &tris, size_t first_new,
+                     Progress &progress) {
+  et.append(n, tris, first_new, progress);
 }
 
 void release_scratch() {
