@@ -195,19 +195,18 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   std::vector<uint64_t> cut_edges(n, 0), hole_edges(n, 0), longest_hole(n, 0);
   // The length of the hole each boundary half-edge of the surface is on
   // (turning about vertices through every triangle, not just the region's).
-  std::vector<uint32_t> hole_len(tris.size(), 0);
+  std::vector<uint32_t> hole_len(tris.size(), 0), on_hole;
   for (uint32_t h = 0; h < tris.size(); ++h) {
     if (reg.twin[h] != kNone || hole_len[h])
       continue;
-    uint32_t len = 0, g = h;
+    on_hole.clear();
+    uint32_t g = h;
     do {
-      ++len;
+      on_hole.push_back(g);
       g = reg.next_hole_edge(g);
     } while (g != h);
-    do {
-      hole_len[g] = len;
-      g = reg.next_hole_edge(g);
-    } while (g != h);
+    for (uint32_t x : on_hole)
+      hole_len[x] = uint32_t(on_hole.size());
   }
   std::vector<uint8_t> walked(tris.size(), 0);
   std::vector<uint32_t> touched;
