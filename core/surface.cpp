@@ -105,9 +105,9 @@ struct EdgeTable {
 
   // Without `angles`, the triangles of an edge come in the order of their
   // numbers, and `angle` and tri_edge are empty: enough for finding edges
-  // and their triangles, and it saves a frame per edge. (With them, an edge of a
-  // single triangle has angle 0 too, for nothing compares it, and an edge
-  // of two has angles 0 and 0 or 2 quarters: see below.)
+  // and their triangles, and it saves a frame per edge. (With them, an edge
+  // of a single triangle has angle 0 too, for nothing compares it, and an
+  // edge of two has angles 0 and 0 or 2 quarters: see below.)
   void build(const double *xyz, size_t n, const std::vector<uint32_t> &tris,
              Progress &progress, bool angles = true) {
     const size_t nt = tris.size() / 3;
