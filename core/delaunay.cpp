@@ -332,6 +332,10 @@ public:
       progress.report(double(done) / double(n));
       size_t m = std::min(batch, n - done);
       for (size_t k = done; k < done + m; ++k) {
+        // The points are in input order, scattered along the insertion
+        // order: ask for the next one while this one goes in.
+        if (k + 1 < n)
+          __builtin_prefetch(xyz + 3 * size_t(brio[k + 1]));
         const double *p = xyz + 3 * size_t(brio[k]);
         Vh v = dt_.insert(Point(p[0], p[1], p[2]), hint);
         v->info().idx = brio[k];
