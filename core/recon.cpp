@@ -135,15 +135,17 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
       any_genus = true;
   // The cut leaves the edge table of the open components, which the
   // closed ones join: the table that the patches below would build.
+  // Where nothing is cut the table stays empty and the patches build it.
   EdgeTablePtr table = new_edge_table();
+  const bool cutting = cut && any_genus;
   const uint64_t handles =
-      cut && any_genus ? cut_handles(lxyz, m, open, progress, *table) : 0;
+      cutting ? cut_handles(lxyz, m, open, progress, *table) : 0;
   if (handles) {
     surf.tris = open;
     surf.tris.insert(surf.tris.end(), closed_part.begin(), closed_part.end());
     append_edges_of(*table, m, surf.tris, open.size() / 3, progress);
-  } else {
-    table = new_edge_table(); // surf.tris as it was: the patches build it
+  } else if (cutting) {
+    table = new_edge_table(); // the open part's alone: not surf.tris's
   }
   // The surface was described after extraction, and cutting handles only
   // takes triangles out of open components: no component to flip, and
