@@ -1087,13 +1087,24 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
     return true;
   };
 
-  std::vector<uint32_t> order;
+  // Vertices by decreasing x. The sort moves each x with its vertex, for
+  // reading it through the vertex number was a cache miss per comparison;
+  // it compares x alone, as before, so the order (ties included) is the
+  // same.
+  struct ByX {
+    double x;
+    uint32_t v;
+  };
+  std::vector<ByX> by_x;
   for (uint32_t v = 0; v < n; ++v)
     if (star.first[v + 1] > star.first[v])
-      order.push_back(v);
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-    return xyz[3 * size_t(a)] > xyz[3 * size_t(b)];
-  });
+      by_x.push_back({xyz[3 * size_t(v)], v});
+  std::sort(by_x.begin(), by_x.end(),
+            [](const ByX &a, const ByX &b) { return a.x > b.x; });
+  std::vector<uint32_t> order(by_x.size());
+  for (size_t i = 0; i < by_x.size(); ++i)
+    order[i] = by_x[i].v;
+  by_x = std::vector<ByX>();
 
   // A clean triangle has exactly two live triangles on each edge: the walk
   // starts there, away from pockets of extra candidates.
