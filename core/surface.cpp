@@ -735,19 +735,31 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
   for (size_t i = 0; i < L + half; ++i)
     std::memcpy(&p[3 * i], xyz + 3 * size_t(loop[i < L ? i : i - L]),
                 3 * sizeof(double));
-  for (size_t i = 0; i < L; ++i) {
-    const double *a = &p[3 * i];
-    for (size_t j = i + half - window; j <= i + half; ++j) {
-      const double *b = &p[3 * j];
-      double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
-      double d2 = dx * dx + dy * dy + dz * dz;
-      if (d2 < best) {
-        const size_t jj = j < L ? j : j - L;
-        if (loop[i] != loop[jj] && !has_edge(loop[i], loop[jj]))
-          best = d2, bi = i, bj = jj;
+  auto shortest = [&](bool new_only) {
+    best = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < L; ++i) {
+      const double *a = &p[3 * i];
+      for (size_t j = i + half - window; j <= i + half; ++j) {
+        const double *b = &p[3 * j];
+        double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+        double d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < best) {
+          const size_t jj = j < L ? j : j - L;
+          if (loop[i] != loop[jj] &&
+              (!new_only || !has_edge(loop[i], loop[jj])))
+            best = d2, bi = i, bj = jj;
+        }
       }
     }
-  }
+  };
+  // The shortest chord of all is nearly always a new edge, and then it is
+  // the shortest new one: asking about the neighbours of only that chord,
+  // not of every chord that was the shortest so far, saves most of the
+  // search's time. Only if it is an edge already is the search run again.
+  shortest(false);
+  if (best < std::numeric_limits<double>::infinity() &&
+      has_edge(loop[bi], loop[bj]))
+    shortest(true);
   if (!(best < std::numeric_limits<double>::infinity()))
     return false;
   // Each part, from one end of the chord round to the other.
