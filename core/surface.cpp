@@ -548,6 +548,16 @@ void fix_fans_in(const VertexStar &ostar, const std::vector<uint32_t> &otri,
   while (!work.empty()) {
     uint32_t v = work.back();
     work.pop_back();
+    // The triangles of the vertices next in line are scattered: ask for
+    // those a few places on while this one is looked at.
+    constexpr size_t kAhead = 4;
+    if (work.size() >= kAhead) {
+      const uint32_t w = work[work.size() - kAhead];
+      for (uint32_t i = ostar.first[w]; i < ostar.first[w + 1]; ++i) {
+        __builtin_prefetch(&in[ostar.tris[i]]);
+        __builtin_prefetch(&otri[3 * size_t(ostar.tris[i])]);
+      }
+    }
     cur.clear();
     for (uint32_t i = ostar.first[v]; i < ostar.first[v + 1]; ++i)
       if (in[ostar.tris[i]])
