@@ -1285,8 +1285,10 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
       for (int j = 0; j < 3; ++j)
         x.v[j] = s[(k + j) % 3];
     } else {
-      std::copy(s, s + 3, x.v);
-      std::sort(x.v, x.v + 3);
+      const uint32_t lo = std::min(s[0], s[1]), hi = std::max(s[0], s[1]);
+      x.v[0] = std::min(lo, s[2]);
+      x.v[1] = std::min(hi, std::max(lo, s[2]));
+      x.v[2] = std::max(hi, s[2]);
     }
     return x;
   };
@@ -1308,12 +1310,27 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
       t[fill[x.v[0]]++] = x;
     }
   }
-  for (size_t v = 0; v + 1 < start.size(); ++v)
-    if (start[v + 1] - start[v] > 1)
-      std::sort(t.begin() + start[v], t.begin() + start[v + 1],
-                [](const Tri &a, const Tri &b) {
-                  return a.v[1] != b.v[1] ? a.v[1] < b.v[1] : a.v[2] < b.v[2];
-                });
+  // A vertex has a few triangles: an insertion sort, inline, costs less
+  // than a call to std::sort for each. (The order is the same: no two
+  // triangles are equal, or equal ones are the same triangle.)
+  auto before = [](const Tri &a, const Tri &b) {
+    return a.v[1] != b.v[1] ? a.v[1] < b.v[1] : a.v[2] < b.v[2];
+  };
+  for (size_t v = 0; v + 1 < start.size(); ++v) {
+    Tri *b = t.data() + start[v];
+    const size_t m = start[v + 1] - start[v];
+    if (m > 32) {
+      std::sort(b, b + m, before);
+      continue;
+    }
+    for (size_t i = 1; i < m; ++i) {
+      const Tri x = b[i];
+      size_t j = i;
+      for (; j > 0 && before(x, b[j - 1]); --j)
+        b[j] = b[j - 1];
+      b[j] = x;
+    }
+  }
   for (size_t i = 0; i < nt; ++i)
     std::memcpy(&tris[3 * i], t[i].v, sizeof t[i].v);
 }
