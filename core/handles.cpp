@@ -31,12 +31,14 @@ constexpr uint64_t kMaxCutPerHoleEdge = 4;
 // points 1.05 or less).
 constexpr uint64_t kMinHolePerCutEdge = 2;
 
+enum : uint8_t { kIn = 1, kSeen = 2 };
+
 // Half-edge h = 3 t + k of triangle t runs from its corner k to corner k + 1.
 inline uint32_t next_in_tri(uint32_t h) { return h % 3 == 2 ? h - 2 : h + 1; }
 
 struct Region {
   std::vector<uint32_t> twin; // the other side's half-edge, or kNone
-  std::vector<uint8_t> in;    // triangle is in the region
+  std::vector<uint8_t> in;    // kIn: triangle is in the region
 
   Region(size_t n, const std::vector<uint32_t> &t, Progress &progress,
          EdgeTable &table)
@@ -44,7 +46,9 @@ struct Region {
     pair_half_edges(n, t, progress, twin, table);
   }
 
-  bool in_region(uint32_t h) const { return h != kNone && in[h / 3]; }
+  bool in_region(uint32_t h) const {
+    return h != kNone && (in[h / 3] & kIn);
+  }
 
   // The boundary half-edge of the region after h (a boundary half-edge of
   // it), found by turning about h's end vertex through region triangles.
@@ -108,40 +112,49 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   if (nt == 0)
     return 0;
   Region reg(n, tris, progress, table);
-  std::vector<double> centre(3 * nt);
-  for (size_t t = 0; t < nt; ++t)
+  // What the growth below reads of a triangle when it reaches it, side by
+  // side: its centre and the least distance to it so far. (In arrays of
+  // their own, each was a cache miss of its own.)
+  struct Reach {
+    double centre[3];
+    double best;
+  };
+  std::vector<Reach> reach(nt);
+  for (size_t t = 0; t < nt; ++t) {
     for (int j = 0; j < 3; ++j)
-      centre[3 * t + j] = (xyz[3 * size_t(tris[3 * t]) + j] +
-                           xyz[3 * size_t(tris[3 * t + 1]) + j] +
-                           xyz[3 * size_t(tris[3 * t + 2]) + j]) /
-                          3;
+      reach[t].centre[j] = (xyz[3 * size_t(tris[3 * t]) + j] +
+                            xyz[3 * size_t(tris[3 * t + 1]) + j] +
+                            xyz[3 * size_t(tris[3 * t + 2]) + j]) /
+                           3;
+    reach[t].best = HUGE_VAL;
+  }
   auto dist = [&](uint32_t a, uint32_t b) {
     double s = 0;
     for (int j = 0; j < 3; ++j) {
-      double d = centre[3 * size_t(a) + j] - centre[3 * size_t(b) + j];
+      double d = reach[a].centre[j] - reach[b].centre[j];
       s += d * d;
     }
     return std::sqrt(s);
   };
 
   // Nearest first from each component's first triangle, so that the fronts
-  // meet on the far side of each handle from where they came.
+  // meet on the far side of each handle from where they came. A triangle
+  // is seen once taken off the queue (kSeen in reg.in, beside kIn, until
+  // the growth ends).
   using Item = std::pair<double, uint32_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  std::vector<uint8_t> seen(nt, 0);
-  std::vector<double> best(nt, HUGE_VAL);
   size_t done = 0;
   for (uint32_t seed = 0; seed < nt; ++seed) {
-    if (seen[seed])
+    if (reg.in[seed] & kSeen)
       continue;
-    best[seed] = 0;
+    reach[seed].best = 0;
     queue.push({0.0, seed});
     while (!queue.empty()) {
       auto [d, t] = queue.top();
       queue.pop();
-      if (seen[t])
+      if (reg.in[t] & kSeen)
         continue;
-      seen[t] = 1;
+      reg.in[t] |= kSeen;
       progress.tick(++done, nt);
       uint32_t r[3];
       int k = 0;
@@ -150,19 +163,22 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
           r[k++] = reg.twin[3 * t + j];
       if (!reg.one_loop(r, k))
         continue; // would join two loops of the region: a handle
-      reg.in[t] = 1;
+      reg.in[t] |= kIn;
       for (int j = 0; j < 3; ++j) {
         uint32_t h = reg.twin[3 * t + j];
-        if (h == kNone || seen[h / 3])
+        if (h == kNone || (reg.in[h / 3] & kSeen))
           continue;
         double dn = d + dist(t, h / 3);
-        if (dn < best[h / 3]) {
-          best[h / 3] = dn;
+        if (dn < reach[h / 3].best) {
+          reach[h / 3].best = dn;
           queue.push({dn, h / 3});
         }
       }
     }
   }
+  reach = std::vector<Reach>();
+  for (uint8_t &f : reg.in) // what follows reads in as in or out
+    f &= kIn;
   // The surface is a manifold: only where the region left triangles out
   // can a vertex have several fans in it.
   fix_fans(n, tris, reg.in, true);
