@@ -24,6 +24,9 @@ constexpr size_t kMinOpenLoop = 8;
 // percent of the surface's larger, the same loops and genus, as many
 // samples kept or more.)
 constexpr size_t kMaxPatch = 16;
+// canonical_order() sorts in two passes, first to at most this many ranges
+// of vertex numbers.
+constexpr uint64_t kCanonRanges = 2048;
 
 double dot3(const double *x, const double *y) {
   return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
@@ -1277,6 +1280,8 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
     uint32_t v[3];
   };
   const size_t nt = tris.size() / 3;
+  if (nt == 0)
+    return;
   auto normalised = [&](size_t i) {
     Tri x;
     const uint32_t *s = &tris[3 * i];
@@ -1293,21 +1298,29 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
     return x;
   };
   // Either way each triangle starts at its smallest vertex: a counting
-  // sort on that vertex, then a sort of each vertex's few triangles.
+  // sort on that vertex, then a sort of each vertex's few triangles. The
+  // triangles come in any order, and a scatter straight to each vertex's
+  // place was a cache miss per triangle; so they go first to a few
+  // thousand ranges of vertex numbers, whose ends stay in cache, and then,
+  // range by range, to their vertex's place in tris.
   uint32_t top = 0;
   for (uint32_t v : tris)
     top = std::max(top, v);
-  std::vector<uint32_t> start(nt ? size_t(top) + 2 : 1, 0);
+  int shift = 0;
+  while ((uint64_t(top) >> shift) >= kCanonRanges)
+    ++shift;
+  const size_t ranges = size_t(top >> shift) + 1;
+  std::vector<uint32_t> rstart(ranges + 1, 0);
   for (size_t i = 0; i < nt; ++i)
-    ++start[size_t(normalised(i).v[0]) + 1];
-  for (size_t v = 0; v + 1 < start.size(); ++v)
-    start[v + 1] += start[v];
+    ++rstart[(normalised(i).v[0] >> shift) + 1];
+  for (size_t r = 0; r < ranges; ++r)
+    rstart[r + 1] += rstart[r];
   std::vector<Tri> t(nt);
   {
-    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    std::vector<uint32_t> fill(rstart.begin(), rstart.end() - 1);
     for (size_t i = 0; i < nt; ++i) {
       const Tri x = normalised(i);
-      t[fill[x.v[0]]++] = x;
+      t[fill[x.v[0] >> shift]++] = x;
     }
   }
   // A vertex has a few triangles: an insertion sort, inline, costs less
@@ -1316,23 +1329,38 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
   auto before = [](const Tri &a, const Tri &b) {
     return a.v[1] != b.v[1] ? a.v[1] < b.v[1] : a.v[2] < b.v[2];
   };
-  for (size_t v = 0; v + 1 < start.size(); ++v) {
-    Tri *b = t.data() + start[v];
-    const size_t m = start[v + 1] - start[v];
-    if (m > 32) {
-      std::sort(b, b + m, before);
-      continue;
+  std::vector<uint32_t> start((size_t(1) << shift) + 1);
+  std::vector<Tri> part;
+  for (size_t r = 0; r < ranges; ++r) {
+    const uint32_t lo = uint32_t(r << shift);
+    std::fill(start.begin(), start.end(), 0);
+    for (uint32_t i = rstart[r]; i < rstart[r + 1]; ++i)
+      ++start[t[i].v[0] - lo + 1];
+    for (size_t v = 0; v + 1 < start.size(); ++v)
+      start[v + 1] += start[v];
+    part.resize(rstart[r + 1] - rstart[r]);
+    for (uint32_t i = rstart[r]; i < rstart[r + 1]; ++i)
+      part[start[t[i].v[0] - lo]++] = t[i];
+    // start[v] is now where vertex lo + v's triangles end in part.
+    for (size_t v = 0; v + 1 < start.size(); ++v) {
+      Tri *b = part.data() + (v ? start[v - 1] : 0);
+      const size_t m = size_t(part.data() + start[v] - b);
+      if (m > 32) {
+        std::sort(b, b + m, before);
+        continue;
+      }
+      for (size_t i = 1; i < m; ++i) {
+        const Tri x = b[i];
+        size_t k = i;
+        for (; k > 0 && before(x, b[k - 1]); --k)
+          b[k] = b[k - 1];
+        b[k] = x;
+      }
     }
-    for (size_t i = 1; i < m; ++i) {
-      const Tri x = b[i];
-      size_t j = i;
-      for (; j > 0 && before(x, b[j - 1]); --j)
-        b[j] = b[j - 1];
-      b[j] = x;
-    }
+    for (size_t i = 0; i < part.size(); ++i)
+      std::memcpy(&tris[3 * (size_t(rstart[r]) + i)], part[i].v,
+                  sizeof part[i].v);
   }
-  for (size_t i = 0; i < nt; ++i)
-    std::memcpy(&tris[3 * i], t[i].v, sizeof t[i].v);
 }
 
 void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
