@@ -219,7 +219,10 @@ const char *sc_path_name(int path);
 /* The result of a reconstruction. Free with sc_mesh_free(). */
 typedef struct sc_mesh {
   /* 3 * triangle_count indices into the caller's point array. Every closed
-   * component is oriented outward (counter-clockwise seen from outside). */
+   * component is oriented outward (counter-clockwise seen from outside).
+   * Each triangle starts at its smallest index, and the triangles come in
+   * increasing order, index by index: the same surface gives the same
+   * array, however the points were added. */
   uint32_t *triangles;
   size_t triangle_count;
   /* 3 * point_count unit normals, one per input point, oriented like the
