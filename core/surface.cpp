@@ -1049,7 +1049,8 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, EdgeTablePtr table,
              size_t max_hole, const std::vector<uint8_t> &boundary,
-             Progress &progress, Surface &out, sc_diag_t &diag) {
+             Progress &progress, Surface &out, sc_diag_t &diag,
+             bool check_vertices) {
   const size_t nt = cand.size() / 3;
   // Only the survivors of pruning take part.
   std::vector<uint32_t> live;
@@ -1272,7 +1273,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   if (max_hole >= 3)
     fill_holes(xyz, n, res, max_hole, boundary, progress, diag, UINT64_MAX,
                &et);
-  describe(xyz, n, res, progress, out, diag, &et);
+  describe(xyz, n, res, progress, out, diag, &et, check_vertices);
 }
 
 void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
@@ -1383,7 +1384,7 @@ void drop_nonmanifold(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
               Progress &progress, Surface &out, sc_diag_t &diag,
-              const EdgeTable *table) {
+              const EdgeTable *table, bool check_vertices) {
   const size_t nr = res.size() / 3;
   EdgeTable own;
   if (!table) {
@@ -1396,7 +1397,7 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
   // fan; a vertex with two fans is pinched. (Before any triangle is
   // flipped below: corners are positions in res.)
   uint64_t pinched = 0;
-  {
+  if (check_vertices) {
     UnionFind corners(3 * nr);
     auto corner = [&](uint32_t t, uint32_t v) {
       const uint32_t *u = &res[3 * size_t(t)];
