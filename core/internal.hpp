@@ -180,8 +180,8 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 // manifold checks; closed components facing inward are flipped. Resets and
 // fills the output fields of diag (triangles, boundary, components ...).
 // `table`, when given, is the edge table of tris (it saves building one).
-// Without check_vertices, the vertices are taken to be manifold (as
-// extraction leaves them) instead of checked: a third of the time.
+// Without check_vertices, the vertices are taken to be manifold, as
+// extraction leaves them, instead of checked (a third of the time here).
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
               Progress &progress, Surface &out, sc_diag_t &diag,
               const EdgeTable *table = nullptr, bool check_vertices = true);

@@ -1325,8 +1325,8 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
     }
   }
   // A vertex has a few triangles: an insertion sort, inline, costs less
-  // than a call to std::sort for each. (The order is the same: no two
-  // triangles are equal, or equal ones are the same triangle.)
+  // than a call to std::sort for each. (Any sort gives the same array:
+  // triangles that compare equal are the same three numbers.)
   auto before = [](const Tri &a, const Tri &b) {
     return a.v[1] != b.v[1] ? a.v[1] < b.v[1] : a.v[2] < b.v[2];
   };
