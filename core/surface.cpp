@@ -546,11 +546,21 @@ void fix_fans_in(const VertexStar &ostar, const std::vector<uint32_t> &otri,
                  std::vector<uint8_t> &in, std::vector<uint32_t> work) {
   std::sort(work.begin(), work.end()); // popped from the back
   work.erase(std::unique(work.begin(), work.end()), work.end());
+  // A vertex is looked at again only if it lost a triangle since it was
+  // last looked at: that look left it one fan, and nothing changed. (A
+  // vertex that loses several triangles is pushed for each; the first
+  // pop looks, the others pass.)
+  std::vector<uint8_t> changed(ostar.first.size() - 1, 0);
+  for (uint32_t v : work)
+    changed[v] = 1;
   std::vector<uint32_t> cur;
   std::vector<int> fan_of;
   while (!work.empty()) {
     uint32_t v = work.back();
     work.pop_back();
+    if (!changed[v])
+      continue;
+    changed[v] = 0;
     // The triangles of the vertices next in line are scattered: ask for
     // those a few places on while this one is looked at.
     constexpr size_t kAhead = 4;
@@ -578,9 +588,13 @@ void fix_fans_in(const VertexStar &ostar, const std::vector<uint32_t> &otri,
       if (fan_of[i] == keep)
         continue;
       in[cur[i]] = 0;
-      for (int k = 0; k < 3; ++k)
-        if (otri[3 * size_t(cur[i]) + k] != v)
-          work.push_back(otri[3 * size_t(cur[i]) + k]);
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t w = otri[3 * size_t(cur[i]) + k];
+        if (w != v) {
+          changed[w] = 1;
+          work.push_back(w);
+        }
+      }
     }
   }
 }
