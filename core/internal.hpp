@@ -169,8 +169,8 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
            Progress &progress, sc_diag_t &diag);
 // Takes the table prune() left for the same candidates and alive flags.
 // Holes mostly rimmed by samples marked in boundary are left open.
-// `check_vertices` as in describe(): pass false only when the surface will
-// be described again before it is output.
+// `check_vertices` as in describe(): pass false only when an open surface
+// will be described again before it is output.
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, EdgeTablePtr table,
              size_t max_hole, const std::vector<uint8_t> &boundary,
@@ -180,8 +180,9 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 // manifold checks; closed components facing inward are flipped. Resets and
 // fills the output fields of diag (triangles, boundary, components ...).
 // `table`, when given, is the edge table of tris (it saves building one).
-// Without check_vertices, the vertices are taken to be manifold, as
-// extraction leaves them, instead of checked (a third of the time here).
+// Without check_vertices, the vertices of a surface with an open component
+// are taken to be manifold, as extraction leaves them, instead of checked
+// (a third of the time here); a closed surface is checked either way.
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
               Progress &progress, Surface &out, sc_diag_t &diag,
               const EdgeTable *table = nullptr, bool check_vertices = true);

@@ -107,9 +107,6 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
         .insert((surf.in_closed(t) ? closed_part : open).end(),
                 &surf.tris[3 * t], &surf.tris[3 * t] + 3);
   if (open.empty()) {
-    // Closed as extracted: described once more, with the check of its
-    // vertices that extraction left out.
-    describe(lxyz, m, surf.tris, progress, surf, diag);
     diag.path = SC_PATH_WATERTIGHT;
     return;
   }
@@ -326,8 +323,8 @@ sc_mesh_t *Recon::finish() {
   // surface the scan missed: the small ones are filled as in the other
   // modes, and no handle is cut.
   const bool scan_holes = watertight && !f.boundary.empty();
-  // Watertight mode describes the surface again once it is closed, and
-  // checks its vertices then (fix_fans_in() leaves one fan at each).
+  // Watertight mode describes an open surface again once it is closed,
+  // and checks its vertices then (fix_fans_in() leaves one fan at each).
   extract(lxyz.data(), m, f.tris, alive, std::move(table),
           scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary,
           progress, surf, diag, !watertight);

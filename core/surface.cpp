@@ -1406,32 +1406,6 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
     table = &own;
   }
   const EdgeTable &rt = *table;
-  // A final check of vertex-manifoldness on the result, counted honestly:
-  // the corners of triangles at a vertex that share an edge there are one
-  // fan; a vertex with two fans is pinched. (Before any triangle is
-  // flipped below: corners are positions in res.)
-  uint64_t pinched = 0;
-  if (check_vertices) {
-    UnionFind corners(3 * nr);
-    auto corner = [&](uint32_t t, uint32_t v) {
-      const uint32_t *u = &res[3 * size_t(t)];
-      return 3 * t + (u[0] == v ? 0 : u[1] == v ? 1 : 2);
-    };
-    for (size_t e = 0; e < rt.edges(); ++e) {
-      const uint64_t k = rt.entries[rt.first[e]].key;
-      const uint32_t t0 = rt.entries[rt.first[e]].tri;
-      for (uint32_t i = rt.first[e] + 1; i < rt.first[e + 1]; ++i) {
-        corners.unite(corner(t0, key_lo(k)),
-                      corner(rt.entries[i].tri, key_lo(k)));
-        corners.unite(corner(t0, uint32_t(k)),
-                      corner(rt.entries[i].tri, uint32_t(k)));
-      }
-    }
-    std::vector<uint8_t> fans(n, 0);
-    for (uint32_t c = 0; c < 3 * nr; ++c)
-      if (corners.find(c) == c && fans[res[c]] < 2 && ++fans[res[c]] == 2)
-        ++pinched;
-  }
   UnionFind uf(nr);
   for (size_t e = 0; e < rt.edges(); ++e)
     for (uint32_t i = rt.first[e] + 1; i < rt.first[e + 1]; ++i)
@@ -1488,6 +1462,37 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
         for (uint32_t u : {key_lo(k), uint32_t(k)})
           loop_of[u] = loop_of[bloops.find(u)];
       }
+  }
+  // A final check of vertex-manifoldness on the result, counted honestly:
+  // the corners of triangles at a vertex that share an edge there are one
+  // fan; a vertex with two fans is pinched. (Before any triangle is
+  // flipped below: corners are positions in res.) Without check_vertices
+  // only a closed surface is checked here: an open one is described again
+  // once closed.
+  bool any_open = false;
+  for (const Surface::Part &p : parts)
+    any_open = any_open || p.boundary_edges > 0;
+  uint64_t pinched = 0;
+  if (check_vertices || !any_open) {
+    UnionFind corners(3 * nr);
+    auto corner = [&](uint32_t t, uint32_t v) {
+      const uint32_t *u = &res[3 * size_t(t)];
+      return 3 * t + (u[0] == v ? 0 : u[1] == v ? 1 : 2);
+    };
+    for (size_t e = 0; e < rt.edges(); ++e) {
+      const uint64_t k = rt.entries[rt.first[e]].key;
+      const uint32_t t0 = rt.entries[rt.first[e]].tri;
+      for (uint32_t i = rt.first[e] + 1; i < rt.first[e + 1]; ++i) {
+        corners.unite(corner(t0, key_lo(k)),
+                      corner(rt.entries[i].tri, key_lo(k)));
+        corners.unite(corner(t0, uint32_t(k)),
+                      corner(rt.entries[i].tri, uint32_t(k)));
+      }
+    }
+    std::vector<uint8_t> fans(n, 0);
+    for (uint32_t c = 0; c < 3 * nr; ++c)
+      if (corners.find(c) == c && fans[res[c]] < 2 && ++fans[res[c]] == 2)
+        ++pinched;
   }
   // Signed volumes about each component's first vertex, for precision.
   std::vector<double> vol(nc, 0.0);
