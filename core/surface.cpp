@@ -37,6 +37,23 @@ inline uint64_t edge_key(uint32_t a, uint32_t b) {
 }
 inline uint32_t key_lo(uint64_t k) { return uint32_t(k >> 32); }
 
+// A stable sort of one bucket of a counting sort. Buckets are nearly always
+// a few items, for which an inline insertion sort costs least (a call to
+// std::sort per bucket cost more than the sorting).
+template <class T, class Less> void sort_bucket(T *b, size_t m, Less less) {
+  if (m > 32) {
+    std::stable_sort(b, b + m, less);
+    return;
+  }
+  for (size_t i = 1; i < m; ++i) {
+    const T x = b[i];
+    size_t j = i;
+    for (; j > 0 && less(x, b[j - 1]); --j)
+      b[j] = b[j - 1];
+    b[j] = x;
+  }
+}
+
 // The large arrays of the edge tables and vertex stars, which one
 // reconstruction builds a dozen times over, go back to a per-thread pool
 // when their table is done, and the next table takes the largest: pages the
@@ -135,25 +152,10 @@ struct EdgeTable {
     }
     // A bucket holds a vertex's edges, filled in triangle order: a stable
     // sort by key alone, which keeps that order among the triangles of an
-    // edge, sorts it by (key, triangle). Buckets are nearly always a few
-    // entries, for which an insertion sort costs least.
-    for (size_t v = 0; v < n; ++v) {
-      Entry *b = entries.data() + count[v];
-      const size_t m = count[v + 1] - count[v];
-      if (m > 32) {
-        std::stable_sort(b, b + m, [](const Entry &x, const Entry &y) {
-          return x.key < y.key;
-        });
-        continue;
-      }
-      for (size_t i = 1; i < m; ++i) {
-        const Entry x = b[i];
-        size_t j = i;
-        for (; j > 0 && b[j - 1].key > x.key; --j)
-          b[j] = b[j - 1];
-        b[j] = x;
-      }
-    }
+    // edge, sorts it by (key, triangle).
+    for (size_t v = 0; v < n; ++v)
+      sort_bucket(entries.data() + count[v], count[v + 1] - count[v],
+                  [](const Entry &x, const Entry &y) { return x.key < y.key; });
     index_edges(nt, &progress, angles);
     angle.clear();
     if (!angles)
@@ -1338,9 +1340,8 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
       t[fill[x.v[0] >> shift]++] = x;
     }
   }
-  // A vertex has a few triangles: an insertion sort, inline, costs less
-  // than a call to std::sort for each. (Any sort gives the same array:
-  // triangles that compare equal are the same three numbers.)
+  // A vertex has a few triangles (see sort_bucket()). Any sort gives the
+  // same array: triangles that compare equal are the same three numbers.
   auto before = [](const Tri &a, const Tri &b) {
     return a.v[1] != b.v[1] ? a.v[1] < b.v[1] : a.v[2] < b.v[2];
   };
@@ -1359,18 +1360,7 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
     // start[v] is now where vertex lo + v's triangles end in part.
     for (size_t v = 0; v + 1 < start.size(); ++v) {
       Tri *b = part.data() + (v ? start[v - 1] : 0);
-      const size_t m = size_t(part.data() + start[v] - b);
-      if (m > 32) {
-        std::sort(b, b + m, before);
-        continue;
-      }
-      for (size_t i = 1; i < m; ++i) {
-        const Tri x = b[i];
-        size_t k = i;
-        for (; k > 0 && before(x, b[k - 1]); --k)
-          b[k] = b[k - 1];
-        b[k] = x;
-      }
+      sort_bucket(b, size_t(part.data() + start[v] - b), before);
     }
     for (size_t i = 0; i < part.size(); ++i)
       std::memcpy(&tris[3 * (size_t(rstart[r]) + i)], part[i].v,
