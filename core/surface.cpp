@@ -1796,15 +1796,29 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
   vkey = std::vector<uint64_t>();
 
   // Calls visit(u) on each used vertex u in the grid cell of point p and in
-  // the 26 around it, in the grid's order.
+  // the 26 around it, in the grid's order. The runs of those 27 cells are
+  // kept for the next sample, which is mostly in the same cell (samples go
+  // in vertex order, which follows the surface).
+  struct Around {
+    CellXyz c;
+    uint32_t first[27], last[27];
+  } around{{0, 0, 0}, {}, {}};
+  bool around_set = false;
   auto for_grid_around = [&](const double *p, auto &&visit) {
     const CellXyz c = cell_of(p);
-    for (int j = 0; j < 27; ++j) {
-      const Run &run = runs[slot(
-          key({c.x + j / 9 - 1, c.y + j / 3 % 3 - 1, c.z + j % 3 - 1}))];
-      for (uint32_t i = run.first; i < run.last; ++i)
-        visit(grid[i]);
+    if (!around_set || c.x != around.c.x || c.y != around.c.y ||
+        c.z != around.c.z) {
+      for (int j = 0; j < 27; ++j) {
+        const Run &run = runs[slot(
+            key({c.x + j / 9 - 1, c.y + j / 3 % 3 - 1, c.z + j % 3 - 1}))];
+        around.first[j] = run.first, around.last[j] = run.last;
+      }
+      around.c = c;
+      around_set = true;
     }
+    for (int j = 0; j < 27; ++j)
+      for (uint32_t i = around.first[j]; i < around.last[j]; ++i)
+        visit(grid[i]);
   };
 
   size_t attached = 0;
