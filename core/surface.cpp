@@ -1484,11 +1484,15 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &res,
       if (corners.find(c) == c && fans[res[c]] < 2 && ++fans[res[c]] == 2)
         ++pinched;
   }
-  // Signed volumes about each component's first vertex, for precision.
+  // Signed volumes about each component's first vertex, for precision: a
+  // closed component facing inward is flipped. (An open one has no inside,
+  // and keeps the orientation it has.)
   std::vector<double> vol(nc, 0.0);
   std::vector<uint32_t> origin(nc, UINT32_MAX);
   for (size_t t = 0; t < nr; ++t) {
     int32_t c = comp_of[t];
+    if (parts[c].boundary_edges != 0)
+      continue;
     if (origin[c] == UINT32_MAX)
       origin[c] = res[3 * t];
     vol[c] += signed_volume6(xyz, &res[3 * t], xyz + 3 * size_t(origin[c]));
