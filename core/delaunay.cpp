@@ -83,6 +83,17 @@ struct CellData {
     CellLabel w;  // watertight mode, after the candidates
   };
   CellData() : cc{0, 0, 0} {}
+  // An infinite cell has no circumcentre: the poles stage marks it with a
+  // NaN that no arithmetic on finite points gives (a NaN made by arithmetic
+  // has no payload), so that the candidates tell it by the bytes they read
+  // anyway.
+  static constexpr uint32_t kInfinite = 0x7fc5a5a5u;
+  void mark_infinite() { std::memcpy(&cc[0], &kInfinite, sizeof kInfinite); }
+  bool infinite() const {
+    uint32_t bits;
+    std::memcpy(&bits, &cc[0], sizeof bits);
+    return bits == kInfinite;
+  }
 };
 typedef CGAL::Triangulation_vertex_base_with_info_3<VertexData, K> Vb;
 typedef CGAL::Triangulation_cell_base_with_info_3<
@@ -507,9 +518,10 @@ private:
   }
 
   // Calls visit(c) on every finite cell c, asking a few cells ahead for the
-  // vertices and, with `neighbours`, the neighbouring cells that the visit
-  // reads: they are scattered over memory, and waiting for each in turn
-  // was most of the time of these passes.
+  // vertices and, with `neighbours`, for the data of the neighbouring cells
+  // at higher addresses (what the candidates read): they are scattered over
+  // memory, and waiting for each in turn was most of the time of these
+  // passes.
   template <class Visit> void for_cells(bool neighbours, Visit &&visit) {
     constexpr int kAhead = 4;
     const auto end = dt_.finite_cells_end();
@@ -522,11 +534,8 @@ private:
           const char *v = reinterpret_cast<const char *>(&*ahead->vertex(j));
           __builtin_prefetch(v);
           __builtin_prefetch(v + 64);
-          if (neighbours) {
-            // Its vertices (is it infinite?) and its circumcentre.
-            __builtin_prefetch(&*ahead->neighbor(j));
+          if (neighbours && &*ahead < &*ahead->neighbor(j))
             __builtin_prefetch(&ahead->neighbor(j)->info());
-          }
         }
         ++ahead;
       }
@@ -542,6 +551,7 @@ private:
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
       if (!dt_.is_infinite(c))
         continue;
+      c->info().mark_infinite();
       int inf = c->index(dt_.infinite_vertex());
       V3 pts[3];
       V3 nrm = hull_normal(c, inf, pts);
@@ -1196,64 +1206,76 @@ private:
     Criteria cr(params);
     const bool detect = detects_boundary(params.mode);
     size_t cells = dt_.number_of_cells(), k = 0;
-    V3 P[3], poles[3], CP[4], Cpoles[4];
+    V3 cc, P[3], poles[3], CP[4], Cpoles[4];
     bool interior[3] = {true, true, true}, Cinterior[4];
     int side1[3] = {0, 0, 0}, Cside[4] = {0, 0, 0, 0};
     uint32_t idx[3], Cidx[4];
     const bool cocone = cr.mode == SC_MODE_COCONE;
-    const Vh inf = dt_.infinite_vertex();
+    // A cell's circumcentre and four vertices, read once for the facets it
+    // handles.
+    auto load = [&](Ch c) {
+      const float *ccc = c->info().cc;
+      cc = {ccc[0], ccc[1], ccc[2]};
+      for (int j = 0; j < 4; ++j) {
+        Vh v = c->vertex(j);
+        const VertexData &d = v->info();
+        CP[j] = v3(v->point());
+        Cpoles[j] = {d.pole[0], d.pole[1], d.pole[2]};
+        Cidx[j] = d.idx;
+        Cinterior[j] = !detect || (d.flags & kVInterior) != 0;
+        if (cocone && Cinterior[j])
+          Cside[j] = cone_side(cc - CP[j], Cpoles[j], cr.sin2_cocone);
+      }
+    };
+    // Facet f of the cell loaded, whose dual Voronoi edge runs from its
+    // circumcentre to `other`, or leaves the hull outward when `ray`.
+    auto facet = [&](int f, V3 other, bool ray) {
+      ++diag.delaunay_facets;
+      for (int j = 0; j < 3; ++j) {
+        const int i = (f + 1 + j) % 4;
+        P[j] = CP[i];
+        poles[j] = Cpoles[i];
+        idx[j] = Cidx[i];
+        interior[j] = Cinterior[i];
+        side1[j] = Cside[i];
+      }
+      if (ray) {
+        V3 nrm = cross(P[1] - P[0], P[2] - P[0]);
+        V3 o = CP[f];
+        other = dot(nrm, o - P[0]) > 0 ? -1.0 * nrm : nrm;
+      }
+      if (is_candidate(cr, P, poles, interior, side1, cc, other, ray)) {
+        tris.push_back(idx[0]);
+        tris.push_back(idx[1]);
+        tris.push_back(idx[2]);
+      }
+    };
+    // Each facet between two finite cells is handled from the cell at the
+    // lower address, which reads nothing of the other cell but its
+    // circumcentre (for_cells() asks for that in advance); the facets of the
+    // hull come after.
     for_cells(true, [&](auto c) {
       progress.tick(k++, cells);
-      const float *ccc = c->info().cc;
-      V3 cc = {ccc[0], ccc[1], ccc[2]};
-      // The cell's four vertices, read once for the facets it handles.
       bool loaded = false;
       for (int f = 0; f < 4; ++f) {
         Ch nb = c->neighbor(f);
-        // Each facet between two finite cells is handled from the cell at
-        // the lower address; that comparison needs no access to nb.
-        if (&*nb < &*c && !nb->has_vertex(inf))
+        if (&*nb < &*c || nb->info().infinite())
           continue;
-        const bool ray = nb->has_vertex(inf);
-        ++diag.delaunay_facets;
         if (!loaded) {
-          for (int j = 0; j < 4; ++j) {
-            Vh v = c->vertex(j);
-            const VertexData &d = v->info();
-            CP[j] = v3(v->point());
-            Cpoles[j] = {d.pole[0], d.pole[1], d.pole[2]};
-            Cidx[j] = d.idx;
-            Cinterior[j] = !detect || (d.flags & kVInterior) != 0;
-            if (cocone && Cinterior[j])
-              Cside[j] = cone_side(cc - CP[j], Cpoles[j], cr.sin2_cocone);
-          }
+          load(c);
           loaded = true;
         }
-        for (int j = 0; j < 3; ++j) {
-          const int i = (f + 1 + j) % 4;
-          P[j] = CP[i];
-          poles[j] = Cpoles[i];
-          idx[j] = Cidx[i];
-          interior[j] = Cinterior[i];
-          side1[j] = Cside[i];
-        }
-        V3 other;
-        if (ray) {
-          // The dual of a hull facet is a ray leaving the hull outward.
-          V3 nrm = cross(P[1] - P[0], P[2] - P[0]);
-          V3 o = CP[f];
-          other = dot(nrm, o - P[0]) > 0 ? -1.0 * nrm : nrm;
-        } else {
-          const float *oc = nb->info().cc;
-          other = {oc[0], oc[1], oc[2]};
-        }
-        if (is_candidate(cr, P, poles, interior, side1, cc, other, ray)) {
-          tris.push_back(idx[0]);
-          tris.push_back(idx[1]);
-          tris.push_back(idx[2]);
-        }
+        const float *oc = nb->info().cc;
+        facet(f, {oc[0], oc[1], oc[2]}, false);
       }
     });
+    std::vector<Ch> outside;
+    dt_.incident_cells(dt_.infinite_vertex(), std::back_inserter(outside));
+    for (Ch o : outside) {
+      Ch c = o->neighbor(o->index(dt_.infinite_vertex()));
+      load(c);
+      facet(c->index(o), {0, 0, 0}, true);
+    }
   }
 
   DT dt_;
