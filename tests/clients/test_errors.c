@@ -230,12 +230,20 @@ static void failed_and_invalid(void) {
   CHECK_EQ(scdt_daemon_stop(&d), 0);
 }
 
-/* Kills the daemon as soon as it reports progress on the job. */
+/* Kills the daemon as soon as it reports progress on the job once armed.
+ * The daemon reports progress while points are still arriving, and the
+ * client may read that report within the submit call: killing the daemon
+ * there would fail the submit itself, which is not what is tested. */
+struct killer {
+  scdt_daemon_t *d;
+  int armed;
+};
+
 static int kill_daemon(void *user, sc_client_job_t *job, uint32_t stage,
                        double fraction) {
-  scdt_daemon_t *d = user;
-  if (stage < 6 && d->pid > 0)
-    kill(d->pid, SIGKILL);
+  struct killer *k = user;
+  if (k->armed && stage < 6 && k->d->pid > 0)
+    kill(k->d->pid, SIGKILL);
   return 0;
 }
 
@@ -250,12 +258,14 @@ static void connection_lost(void) {
   double *xyz = scdt_sample(SC_SURF_TORUS, n, 4);
   sc_client_params_t p;
   sc_client_params_init(&p);
+  struct killer killer = {&d, 0};
   p.progress = kill_daemon;
-  p.progress_user = &d;
+  p.progress_user = &killer;
   sc_client_job_t *j, *k;
   CHECK_EQ(sc_client_submit(c, &p, xyz, n, &j), 0);
   /* A second job, whose end is the same. */
   CHECK_EQ(sc_client_submit(c, NULL, xyz, 1000, &k), 0);
+  killer.armed = 1;
   CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), SC_CLIENT_ELOST);
   /* A killed daemon shows as end of file or, when the kernel still held
    * unread upload bytes for it, as a reset: either message names the
