@@ -547,16 +547,17 @@ private:
     const float kHull = std::numeric_limits<float>::infinity();
 
     // Samples on the convex hull: the pole is at infinity, in the direction
-    // of the average outward normal of the hull facets around them.
-    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
-      if (!dt_.is_infinite(c))
-        continue;
+    // of the average outward normal of the hull facets around them. The
+    // infinite cells are kept for boundary detection and the candidates.
+    infinite_.clear();
+    dt_.incident_cells(dt_.infinite_vertex(), std::back_inserter(infinite_));
+    for (Ch c : infinite_) {
       c->info().mark_infinite();
       int inf = c->index(dt_.infinite_vertex());
       V3 pts[3];
       V3 nrm = hull_normal(c, inf, pts);
       // On a grid of 2^-30: sums of such numbers are exact, so they do not
-      // depend on the order of the cells in memory.
+      // depend on the order of the cells.
       for (double *x : {&nrm.x, &nrm.y, &nrm.z})
         *x = std::ldexp(std::nearbyint(std::ldexp(*x, 30)), -30);
       for (int k = 0; k < 3; ++k) {
@@ -649,8 +650,7 @@ private:
     // facet corners at it (sorting corners by vertex cost more than the
     // rest of this stage on small input, and a vector of (vertex, normal)
     // pairs grown one by one was most of its memory).
-    std::vector<Ch> outside;
-    dt_.incident_cells(dt_.infinite_vertex(), std::back_inserter(outside));
+    const std::vector<Ch> &outside = infinite_;
     std::vector<V3> hull(outside.size());
     std::vector<uint32_t> head(dt_.number_of_vertices(), UINT32_MAX),
         next(3 * outside.size());
@@ -678,7 +678,6 @@ private:
             v->info().r2 = kInf;
     }
     hull = {};
-    outside = {};
     next = {};
     head = {};
 
@@ -1269,13 +1268,12 @@ private:
         facet(f, {oc[0], oc[1], oc[2]}, false);
       }
     });
-    std::vector<Ch> outside;
-    dt_.incident_cells(dt_.infinite_vertex(), std::back_inserter(outside));
-    for (Ch o : outside) {
+    for (Ch o : infinite_) {
       Ch c = o->neighbor(o->index(dt_.infinite_vertex()));
       load(c);
       facet(c->index(o), {0, 0, 0}, true);
     }
+    infinite_ = {};
   }
 
   DT dt_;
@@ -1284,6 +1282,7 @@ private:
   std::vector<uint32_t> hilbert_;
   std::vector<Vh> vh_; // vertex number -> handle, while closing
   std::vector<Ch> star_; // scratch of repair_vertex()
+  std::vector<Ch> infinite_; // from the poles stage to the candidates
   std::vector<uint32_t> parent_, size_;
 };
 
