@@ -5,7 +5,6 @@
 
 #include "internal.hpp"
 
-#include <atomic>
 #include <climits>
 #include <cmath>
 #include <cstdarg>
@@ -16,48 +15,7 @@
 
 #ifdef __GLIBC__
 #include <malloc.h>
-#include <sys/mman.h>
-#include <unistd.h>
 #endif
-
-namespace {
-
-// Set once sc_tune_allocator() has taken: large blocks come from the heap,
-// which keeps its top when freed.
-std::atomic<bool> allocator_tuned{false};
-
-// Where the allocator is tuned, makes room at the top of the heap for a
-// reconstruction's peak and asks the kernel to back it with 2 MiB pages
-// (transparent huge pages: honoured in the kernel's "madvise" and "always"
-// modes, ignored in "never"). The reconstruction's blocks are then carved
-// from that room. The triangulation alone touches some 50 000 pages of
-// 4 KiB on 362k points, each a page fault (about 11 us on a virtual
-// machine), and its passes over the cells are scattered over all of them;
-// in 2 MiB pages it is about a hundred faults and far fewer TLB misses.
-void prepare_heap(uint64_t bytes) {
-#if defined(__GLIBC__) && defined(MADV_HUGEPAGE)
-  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-  if (!allocator_tuned.load(std::memory_order_relaxed) || bytes < 2 * kHuge)
-    return;
-  // (Nor for more than the machine has: that reconstruction fails anyway,
-  // and says why.)
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  if (pages <= 0 || page <= 0 || bytes / uint64_t(page) >= uint64_t(pages))
-    return;
-  void *room = std::malloc(size_t(bytes));
-  if (!room)
-    return; // (the reconstruction will say so, if it runs out)
-  const uintptr_t lo = (uintptr_t(room) + kHuge - 1) & ~(kHuge - 1),
-                  hi = (uintptr_t(room) + size_t(bytes)) & ~(kHuge - 1);
-  if (hi > lo)
-    (void)madvise(reinterpret_cast<void *>(lo), hi - lo, MADV_HUGEPAGE);
-  std::free(room);
-#else
-  (void)bytes;
-#endif
-}
-
-} // namespace
 
 extern "C" const char *sc_strerror(int code) {
   switch (code) {
@@ -290,7 +248,6 @@ extern "C" int sc_reconstruct(const double *xyz, size_t n,
   if (rc)
     return rc;
   return guarded(msg, msg_len, [&] {
-    prepare_heap(sc_estimate_bytes(n));
     sc::Recon r(p);
     r.borrow(xyz, n);
     *out = r.finish();
@@ -315,11 +272,8 @@ extern "C" int sc_tune_allocator(void) {
 #ifdef __GLIBC__
   // Large blocks from the heap rather than from mmap(), and the heap's top
   // kept when freed: a later allocation reuses pages already faulted in.
-  if (mallopt(M_MMAP_MAX, 0) == 1 &&
-      mallopt(M_TRIM_THRESHOLD, INT_MAX) == 1) {
-    allocator_tuned.store(true, std::memory_order_relaxed);
+  if (mallopt(M_MMAP_MAX, 0) == 1 && mallopt(M_TRIM_THRESHOLD, INT_MAX) == 1)
     return SC_OK;
-  }
 #endif
   return SC_EINTERNAL;
 }

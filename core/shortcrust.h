@@ -285,13 +285,6 @@ uint64_t sc_estimate_bytes(uint64_t n);
  * is for programs to call, once, before their first reconstruction. (A
  * program that reconstructs on several threads and must shrink when idle
  * should not: malloc_trim() does not shrink the heaps of threads' arenas.)
- * Once it is called, each sc_reconstruct() of more than a few thousand
- * points first grows the heap by its peak (sc_estimate_bytes(); address
- * space, not memory, until it is used) and asks the kernel to back that
- * part of the heap with transparent huge pages (madvise(MADV_HUGEPAGE);
- * the kernel's THP setting decides): on 362k points the page faults go
- * from 63 000 to 2 500 and the reconstruction is 7% faster. The advice
- * stays with those addresses for the life of the process.
  * Returns 0, or SC_EINTERNAL when the allocator is not glibc's or refused.
  */
 int sc_tune_allocator(void);

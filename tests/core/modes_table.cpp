@@ -70,70 +70,6 @@ void cold_heap() {
 #endif
 }
 
-// CGAL's Delaunay construction of the points, timed in a process of its
-// own, forked before the file's first reconstruction: sc_reconstruct()
-// advises the heap it grows to take huge pages (see sc_tune_allocator()),
-// the advice stays with those addresses, and the yardstick is CGAL's
-// construction as a program of its own would run it, without that advice.
-class Yardstick {
-public:
-  explicit Yardstick(const std::vector<Point> &points) {
-    if (pipe(ask_) != 0 || pipe(answer_) != 0) {
-      std::perror("pipe");
-      return;
-    }
-    std::fflush(stdout);
-    pid_ = fork();
-    if (pid_ < 0) {
-      std::perror("fork");
-      return;
-    }
-    if (pid_ > 0) {
-      close(ask_[0]);
-      close(answer_[1]);
-      return;
-    }
-    close(ask_[1]);
-    close(answer_[0]);
-    char go;
-    while (read(ask_[0], &go, 1) == 1) {
-      cold_heap();
-      const double t0 = now();
-      double t;
-      {
-        CGAL::Delaunay_triangulation_3<K> dt(points.begin(), points.end());
-        t = dt.number_of_vertices() == 0 ? -1 : now() - t0;
-      }
-      if (write(answer_[1], &t, sizeof t) != ssize_t(sizeof t))
-        break;
-    }
-    std::_Exit(0);
-  }
-  ~Yardstick() {
-    if (pid_ <= 0)
-      return;
-    close(ask_[1]);
-    close(answer_[0]);
-    waitpid(pid_, nullptr, 0);
-  }
-  Yardstick(const Yardstick &) = delete;
-  Yardstick &operator=(const Yardstick &) = delete;
-
-  // Seconds of one construction, or a negative number if it failed.
-  double run() {
-    const char go = 1;
-    double t = -1;
-    if (pid_ <= 0 || write(ask_[1], &go, 1) != 1 ||
-        read(answer_[0], &t, sizeof t) != ssize_t(sizeof t))
-      return -1;
-    return t;
-  }
-
-private:
-  pid_t pid_ = -1;
-  int ask_[2] = {-1, -1}, answer_[2] = {-1, -1};
-};
-
 struct Reference {
   std::vector<Triangle> tris;
   std::unique_ptr<Tree> tree;
@@ -260,15 +196,16 @@ int measure(const std::string &dir, const std::string &name, int repeat,
   std::vector<sc_mesh_t *> meshes(nmodes, nullptr);
   std::vector<int> rc(nmodes, 0);
   std::vector<std::string> failure(nmodes);
-  Yardstick yardstick(points);
   for (int r = 0; r < repeat || (dt_total < kMinYardstick && r < kMaxRounds);
        ++r) {
-    const double t = yardstick.run();
-    if (t < 0) {
-      std::fprintf(stderr, "%s: CGAL's Delaunay construction failed\n",
-                   name.c_str());
-      return 1;
+    cold_heap();
+    t0 = now();
+    {
+      CGAL::Delaunay_triangulation_3<K> dt(points.begin(), points.end());
+      if (dt.number_of_vertices() == 0)
+        return 1;
     }
+    const double t = now() - t0;
     dt_seconds = std::min(dt_seconds, t);
     dt_total += t;
     for (size_t m = 0; m < nmodes; ++m) {
