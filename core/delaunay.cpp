@@ -7,7 +7,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 
 #include "internal.hpp"
+#include "prefault.hpp"
 
+// Blocks of cells and vertices come with their pages resident (see
+// prefault.hpp); CGAL's own default is std::allocator.
+#define CGAL_ALLOCATOR(T) sc::PrefaultAllocator<T>
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>

@@ -1,0 +1,47 @@
+// The allocator of the triangulation's cells and vertices: CGAL's
+// Compact_container writes to every element of a block as soon as it has
+// allocated it (threading its free list), so every page of the block is
+// touched at once. Asking the kernel for those pages in one call
+// (MADV_POPULATE_WRITE, Linux 5.14) instead of one page fault each saves a
+// trap per page: about 10 us on a virtual machine (where the
+// triangulation of 362k points went from 1.92 to 1.63 s), around 1 us on
+// bare metal. Included before any CGAL header, for CGAL_ALLOCATOR() to
+// name it.
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+#ifndef SC_CORE_PREFAULT_HPP
+#define SC_CORE_PREFAULT_HPP
+
+#include <cstddef>
+#include <memory>
+
+namespace sc {
+
+// Makes the whole pages of [p, p + bytes) resident and writable, when they
+// are many enough to be worth a call; where the kernel cannot, they are
+// faulted in as they are touched, as before (prefault.cpp).
+void prefault(void *p, size_t bytes);
+
+template <class T> struct PrefaultAllocator {
+  typedef T value_type;
+  PrefaultAllocator() = default;
+  template <class U> PrefaultAllocator(const PrefaultAllocator<U> &) {}
+  T *allocate(size_t n) {
+    T *p = std::allocator<T>().allocate(n);
+    prefault(p, n * sizeof(T));
+    return p;
+  }
+  void deallocate(T *p, size_t n) { std::allocator<T>().deallocate(p, n); }
+};
+template <class T, class U>
+bool operator==(const PrefaultAllocator<T> &, const PrefaultAllocator<U> &) {
+  return true;
+}
+template <class T, class U>
+bool operator!=(const PrefaultAllocator<T> &, const PrefaultAllocator<U> &) {
+  return false;
+}
+
+} // namespace sc
+
+#endif
