@@ -10,7 +10,10 @@
 #include "prefault.hpp"
 
 // Blocks of cells and vertices come with their pages resident (see
-// prefault.hpp); CGAL's own default is std::allocator.
+// prefault.hpp); CGAL's own default is std::allocator. The macro is CGAL's
+// hook for its containers' default allocator, and it must come before
+// CGAL's headers; it changes only this file's instantiations, whose cell
+// and vertex types are this file's own.
 #define CGAL_ALLOCATOR(T) sc::PrefaultAllocator<T>
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
