@@ -27,51 +27,10 @@ void sc_cli_error(const char *fmt, ...) {
   va_end(ap);
 }
 
-static const char *const mode_names[SC_MODE_COUNT_] = {
-    [SC_MODE_SHORTCRUST] = "shortcrust",
-    [SC_MODE_COCONE] = "cocone",
-    [SC_MODE_BOUNDARY] = "boundary",
-    [SC_MODE_WATERTIGHT] = "watertight",
-    [SC_MODE_AUTO] = "auto",
-};
-
 void sc_cli_job_init(sc_cli_job_opts_t *o) {
   memset(o, 0, sizeof *o);
   sc_params_init(&o->params);
   o->normals = 1;
-}
-
-void sc_cli_job_usage_params(FILE *f) {
-  sc_params_t d;
-  sc_params_init(&d);
-  fprintf(f,
-          "  -o, --output OUT      the mesh to write (required)\n"
-          "  -m, --mode MODE       cocone, shortcrust, boundary (scans with a "
-          "boundary),\n"
-          "                        watertight (close every hole) or auto "
-          "(default %s)\n"
-          "      --r R             shortcrust sampling parameter, in (0, 0.5) "
-          "(default %g)\n"
-          "      --theta DEG       cocone half-width in degrees, in (0, 90) "
-          "(default %g)\n"
-          "      --max-hole N      close holes of at most N edges, 0 = never "
-          "(default %d)\n"
-          "      --paper-pruning   prune every edge with a single candidate, "
-          "as in the paper\n"
-          "      --labels          watertight mode: close the surface by "
-          "labelling Delaunay\n"
-          "                        cells inside or outside first (default: "
-          "least-area\n"
-          "                        patches first, labelling where they "
-          "cannot close it)\n"
-          "      --rho RHO         boundary detection: ratio of cocone extent "
-          "to pole height,\n"
-          "                        in (0, 10] (default %g)\n"
-          "      --alpha DEG       boundary detection: largest angle between "
-          "neighbouring\n"
-          "                        poles, in (0, 90] degrees (default %g)\n",
-          sc_cli_mode_name(d.mode), d.r, d.cocone_theta * 180 / SC_PI,
-          d.max_hole_edges, d.boundary_rho, d.boundary_alpha * 180 / SC_PI);
 }
 
 void sc_cli_job_usage_output(FILE *f) {
@@ -81,67 +40,6 @@ void sc_cli_job_usage_output(FILE *f) {
         "  -q, --quiet           no progress and no summary; errors only\n"
         "  -h, --help            this text\n\n",
         f);
-}
-
-int sc_cli_job_option(sc_cli_job_opts_t *o, int c, const char *arg) {
-  double v;
-  long l;
-  switch (c) {
-  case SC_CLI_OPT_MAX_HOLE:
-    if (sc_cli_parse_int("--max-hole", arg, 0, 100000, &l) < 0)
-      return -1;
-    o->params.max_hole_edges = (int)l;
-    return 1;
-  case SC_CLI_OPT_PAPER:
-    o->params.paper_pruning = 1;
-    return 1;
-  case SC_CLI_OPT_LABELS:
-    o->params.watertight_labels = 1;
-    return 1;
-  case SC_CLI_OPT_RHO:
-    if (sc_cli_parse_double("--rho", arg, &o->params.boundary_rho) < 0)
-      return -1;
-    if (!(o->params.boundary_rho > 0)) {
-      sc_cli_error("--rho: must be positive, got %s", arg);
-      return -1;
-    }
-    return 1;
-  case SC_CLI_OPT_ALPHA:
-    if (sc_cli_parse_double("--alpha", arg, &v) < 0)
-      return -1;
-    if (!(v > 0)) {
-      sc_cli_error("--alpha: must be positive, got %s", arg);
-      return -1;
-    }
-    o->params.boundary_alpha = v * SC_PI / 180;
-    return 1;
-  case 'o':
-    o->out_path = arg;
-    return 1;
-  case 'm':
-    return sc_cli_parse_mode("--mode", arg, &o->params.mode) < 0 ? -1 : 1;
-  case SC_CLI_OPT_R:
-    return sc_cli_parse_double("--r", arg, &o->params.r) < 0 ? -1 : 1;
-  case SC_CLI_OPT_THETA:
-    if (sc_cli_parse_double("--theta", arg, &v) < 0)
-      return -1;
-    o->params.cocone_theta = v * SC_PI / 180;
-    return 1;
-  case SC_CLI_OPT_REPORT:
-    o->report = arg;
-    return 1;
-  case SC_CLI_OPT_ASCII:
-    o->ascii = 1;
-    return 1;
-  case SC_CLI_OPT_NO_NORMALS:
-    o->normals = 0;
-    return 1;
-  case 'q':
-    o->quiet = 1;
-    return 1;
-  default:
-    return 0;
-  }
 }
 
 int sc_cli_bad_option(const char *cmd, int c, char **argv) {
@@ -169,32 +67,14 @@ int sc_cli_job_files(const char *cmd, sc_cli_job_opts_t *o, int argc,
     sc_cli_error("%s: no output file: give -o OUT", cmd);
     return -1;
   }
+  /* Before any file is read: a parameter out of range is the command
+   * line's fault, whatever the input. */
+  char msg[256];
+  if (sc_params_check(&o->params, msg, sizeof msg) != SC_OK) {
+    sc_cli_error("%s: %s", cmd, msg);
+    return -1;
+  }
   return 0;
-}
-
-const char *sc_cli_mode_name(sc_mode_t mode) {
-  if ((int)mode < 0 || mode >= SC_MODE_COUNT_ || !mode_names[mode])
-    return "?";
-  return mode_names[mode];
-}
-
-int sc_cli_parse_mode(const char *opt, const char *arg, sc_mode_t *out) {
-  for (int m = 0; m < SC_MODE_COUNT_; ++m) {
-    if (mode_names[m] && strcmp(arg, mode_names[m]) == 0) {
-      *out = (sc_mode_t)m;
-      return 0;
-    }
-  }
-  char list[256] = "";
-  for (int m = 0; m < SC_MODE_COUNT_; ++m) {
-    if (!mode_names[m])
-      continue;
-    if (list[0])
-      strncat(list, ", ", sizeof list - strlen(list) - 1);
-    strncat(list, mode_names[m], sizeof list - strlen(list) - 1);
-  }
-  sc_cli_error("%s: unknown mode '%s' (expected one of: %s)", opt, arg, list);
-  return -1;
 }
 
 int sc_cli_parse_double(const char *opt, const char *arg, double *out) {
@@ -317,7 +197,7 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
     fprintf(f, " (%llu duplicates merged)",
             (unsigned long long)d->duplicates_merged);
   fprintf(f, " -> %llu triangles in %s, mode %s", (unsigned long long)d->triangles,
-          r->output, sc_cli_mode_name(r->params.mode));
+          r->output, sc_mode_name(r->params.mode));
   if (r->params.mode == SC_MODE_SHORTCRUST)
     fprintf(f, " (r = %g)", r->params.r);
   fprintf(f, ".\n");
@@ -372,53 +252,9 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
   sc_file_json_string(f, r->input);
   fputs(",\n  \"output\": ", f);
   sc_file_json_string(f, r->output);
-  fputs(",\n  \"params\": {\"mode\": ", f);
-  sc_file_json_string(f, sc_cli_mode_name(r->params.mode));
-  fprintf(f,
-          ", \"r\": %.17g, \"cocone_theta\": %.17g, \"paper_pruning\": %d, "
-          "\"max_hole_edges\": %d, \"threads\": %d, \"boundary_rho\": %.17g, "
-          "\"boundary_alpha\": %.17g, \"watertight_labels\": %d},\n",
-          r->params.r, r->params.cocone_theta, r->params.paper_pruning,
-          r->params.max_hole_edges, r->params.threads, r->params.boundary_rho,
-          r->params.boundary_alpha, r->params.watertight_labels);
-#define U64_(field) fprintf(f, "  \"" #field "\": %llu,\n", (unsigned long long)d->field)
-  U64_(points_in);
-  U64_(duplicates_merged);
-  U64_(delaunay_vertices);
-  U64_(delaunay_cells);
-  U64_(delaunay_facets);
-  U64_(hull_vertices);
-  U64_(degenerate_cells);
-  U64_(candidates);
-  U64_(pruned);
-  U64_(triangles);
-  U64_(walk_rejected);
-  U64_(holes_filled);
-  U64_(hole_triangles);
-  U64_(samples_unused);
-  U64_(boundary_edges);
-  U64_(boundary_loops);
-  U64_(nonmanifold_edges);
-  U64_(nonmanifold_vertices);
-  U64_(components);
-  U64_(closed_components);
-  U64_(boundary_samples);
-  U64_(longest_loop);
-  U64_(cells_relabelled);
-  U64_(bubbles_dropped);
-  U64_(samples_attached);
-  U64_(handles_cut);
-#undef U64_
-  fputs("  \"path\": ", f);
-  sc_file_json_string(f, sc_path_name(d->path));
-  fprintf(f, ",\n  \"loops_by_length\": [%llu, %llu, %llu, %llu],\n",
-          (unsigned long long)d->loops_by_length[0],
-          (unsigned long long)d->loops_by_length[1],
-          (unsigned long long)d->loops_by_length[2],
-          (unsigned long long)d->loops_by_length[3]);
-  fprintf(f, "  \"closed\": %s,\n", d->closed ? "true" : "false");
-  fprintf(f, "  \"euler\": %lld,\n  \"genus\": %lld,\n", (long long)d->euler,
-          (long long)d->genus);
+  fputs(",\n", f);
+  sc_cli_report_params(f, &r->params);
+  sc_cli_report_diag(f, d);
   fputs("  \"component_genus\": [", f);
   for (size_t i = 0; r->component_genus && i < r->component_count; ++i)
     fprintf(f, "%s%d", i ? ", " : "", r->component_genus[i]);

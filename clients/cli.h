@@ -11,14 +11,13 @@
 #ifndef SC_CLI_H
 #define SC_CLI_H
 
+#include <getopt.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 
 #include "files.h"
 #include "shortcrust.h"
-
-#define SC_PI 3.14159265358979323846
 
 /* Exit codes of every subcommand. */
 enum {
@@ -38,12 +37,12 @@ int sc_cli_parse_int(const char *opt, const char *arg, long min, long max,
                      long *out);
 
 /*
- * The options every mesh-producing subcommand takes: -o, -m, --r, --theta,
- * --max-hole, --paper-pruning, --labels, --rho, --alpha, --report, --ascii,
- * --no-normals, -q. A subcommand lists
- * SC_CLI_JOB_LONG_OPTIONS in its getopt_long table (and "o:m:q" in its short
- * options), numbers its own long options from SC_CLI_OPT_OWN, and passes
- * each getopt_long result to sc_cli_job_option() first.
+ * The options every mesh-producing subcommand takes: -o, one per parameter
+ * of the core's table (SC_PARAM_MAP in shortcrust.h; those the daemon does
+ * not take only where local is 1), --report, --ascii, --no-normals, -q.
+ * A subcommand builds its getopt_long tables with sc_cli_job_getopt(),
+ * adding its own options (numbered from SC_CLI_OPT_OWN, or short letters),
+ * and passes each getopt_long result to sc_cli_job_option() first.
  */
 typedef struct sc_cli_job_opts {
   sc_params_t params;
@@ -52,38 +51,28 @@ typedef struct sc_cli_job_opts {
 } sc_cli_job_opts_t;
 
 enum {
-  SC_CLI_OPT_R = 256,
-  SC_CLI_OPT_THETA,
-  SC_CLI_OPT_REPORT,
+  SC_CLI_OPT_REPORT = 256,
   SC_CLI_OPT_ASCII,
   SC_CLI_OPT_NO_NORMALS,
-  SC_CLI_OPT_MAX_HOLE,
-  SC_CLI_OPT_PAPER,
-  SC_CLI_OPT_LABELS,
-  SC_CLI_OPT_RHO,
-  SC_CLI_OPT_ALPHA,
-  SC_CLI_OPT_OWN
+  SC_CLI_OPT_PARAM,            /* + the row of the parameter table */
+  SC_CLI_OPT_OWN = SC_CLI_OPT_PARAM + 64
 };
 
-#define SC_CLI_JOB_LONG_OPTIONS                                              \
-  {"output", required_argument, NULL, 'o'},                                  \
-      {"mode", required_argument, NULL, 'm'},                                \
-      {"r", required_argument, NULL, SC_CLI_OPT_R},                          \
-      {"theta", required_argument, NULL, SC_CLI_OPT_THETA},                  \
-      {"report", required_argument, NULL, SC_CLI_OPT_REPORT},                \
-      {"ascii", no_argument, NULL, SC_CLI_OPT_ASCII},                        \
-      {"no-normals", no_argument, NULL, SC_CLI_OPT_NO_NORMALS},              \
-      {"max-hole", required_argument, NULL, SC_CLI_OPT_MAX_HOLE},            \
-      {"paper-pruning", no_argument, NULL, SC_CLI_OPT_PAPER},                \
-      {"labels", no_argument, NULL, SC_CLI_OPT_LABELS},                      \
-      {"rho", required_argument, NULL, SC_CLI_OPT_RHO},                      \
-      {"alpha", required_argument, NULL, SC_CLI_OPT_ALPHA},                  \
-      {"quiet", no_argument, NULL, 'q'}
+#define SC_CLI_MAX_OPTIONS 96
+typedef struct sc_cli_getopt {
+  struct option long_options[SC_CLI_MAX_OPTIONS];
+  char short_options[64];
+} sc_cli_getopt_t;
 
-/* The help lines of the shared options: those that choose the job (-o,
- * -m, --r, --theta to --alpha, with their defaults), and those about the output
- * (--report to --help). A subcommand prints its own options between. */
-void sc_cli_job_usage_params(FILE *f);
+/* Fills g: the shared options, then own (ending with a NULL name; may be
+ * NULL) and own_short (getopt's letters; may be NULL). -1 when they do not
+ * fit. */
+int sc_cli_job_getopt(sc_cli_getopt_t *g, int local,
+                      const struct option *own, const char *own_short);
+/* The help lines of the options that choose the job: -o and the
+ * parameters, with their ranges and defaults (local as above). A
+ * subcommand prints its own options, then sc_cli_job_usage_output()'s. */
+void sc_cli_job_usage_params(FILE *f, int local);
 void sc_cli_job_usage_output(FILE *f);
 /* The defaults: the core's parameters, normals on. */
 void sc_cli_job_init(sc_cli_job_opts_t *o);
@@ -93,13 +82,12 @@ int sc_cli_job_option(sc_cli_job_opts_t *o, int c, const char *arg);
 /* Reports a getopt_long error (':' for a missing value, anything else an
  * unknown option) for subcommand cmd; returns SC_EXIT_USAGE. */
 int sc_cli_bad_option(const char *cmd, int c, char **argv);
-/* After the options: exactly one input file, and -o. Returns 0, or prints
- * what is missing and returns -1. */
+/* After the options: exactly one input file, and -o, and the parameters
+ * within the core's ranges. Returns 0, or prints what is wrong and
+ * returns -1. */
 int sc_cli_job_files(const char *cmd, sc_cli_job_opts_t *o, int argc,
                      char **argv);
 
-/* The name of a mode as the --mode option spells it. */
-const char *sc_cli_mode_name(sc_mode_t mode);
 
 /*
  * Progress on stderr, redrawn in place, when stderr is a terminal and the
@@ -141,6 +129,11 @@ typedef struct sc_cli_result {
 /* The closing paragraph: points, duplicates, triangles, closed or not,
  * components, genus, time per stage. */
 void sc_cli_summary(FILE *f, const sc_cli_result_t *r);
+
+/* The report's "params" line and its diagnostics but the seconds, made
+ * from the core's tables. */
+void sc_cli_report_params(FILE *f, const sc_params_t *p);
+void sc_cli_report_diag(FILE *f, const sc_diag_t *d);
 
 /* The diagnostics as one JSON object; malloc'd, NULL when out of memory. */
 char *sc_cli_report_json(const sc_cli_result_t *r);

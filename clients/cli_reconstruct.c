@@ -16,8 +16,6 @@
 #include "files.h"
 
 static void usage(FILE *f) {
-  sc_params_t d;
-  sc_params_init(&d);
   fputs("usage: shortcrust reconstruct IN -o OUT [options]\n\n"
         "Reconstructs a triangle mesh from the points of IN and writes it to\n"
         "OUT. IN may be .ply (ascii or binary), .xyz/.txt/.pts/.csv, .off or\n"
@@ -26,12 +24,7 @@ static void usage(FILE *f) {
         "point is written, in input order, so triangle indices refer to IN.\n\n"
         "options:\n",
         f);
-  sc_cli_job_usage_params(f);
-  fprintf(f,
-          "  -j, --threads N       threads for the Delaunay triangulation, 0 = "
-          "one per core\n"
-          "                        (default %d)\n",
-          d.threads);
+  sc_cli_job_usage_params(f, 1);
   sc_cli_job_usage_output(f);
   fputs("Progress goes to stderr when it is a terminal; the summary goes to\n"
         "stdout. Exit status: 0 done, 1 failed (the message says why), 2 bad\n"
@@ -39,9 +32,7 @@ static void usage(FILE *f) {
         f);
 }
 
-static const struct option long_options[] = {
-    SC_CLI_JOB_LONG_OPTIONS,
-    {"threads", required_argument, NULL, 'j'},
+static const struct option own_options[] = {
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
 };
@@ -50,22 +41,22 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   sc_cli_job_opts_t o;
   sc_cli_job_init(&o);
   sc_params_t *params = &o.params;
-  long l;
+  sc_cli_getopt_t g;
+  if (sc_cli_job_getopt(&g, 1, own_options, "h") < 0) {
+    sc_cli_error("reconstruct: too many options");
+    return SC_EXIT_FAILURE;
+  }
 
   opterr = 0;
   int c;
-  while ((c = getopt_long(argc, argv, ":o:m:j:qh", long_options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, g.short_options, g.long_options,
+                          NULL)) != -1) {
     int shared = sc_cli_job_option(&o, c, optarg);
     if (shared < 0)
       return SC_EXIT_USAGE;
     if (shared > 0)
       continue;
     switch (c) {
-    case 'j':
-      if (sc_cli_parse_int("--threads", optarg, 0, 1024, &l) < 0)
-        return SC_EXIT_USAGE;
-      params->threads = (int)l;
-      break;
     case 'h':
       usage(stdout);
       return SC_EXIT_OK;

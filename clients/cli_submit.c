@@ -31,7 +31,7 @@ static void usage(FILE *f) {
         "sent, and a daemon too old to take the others refuses the job.\n\n"
         "options:\n",
         f);
-  sc_cli_job_usage_params(f);
+  sc_cli_job_usage_params(f, 0);
   fprintf(f, "      --socket PATH     the daemon's socket (default %s)\n",
           sc_client_default_socket(sock, sizeof sock));
   sc_cli_job_usage_output(f);
@@ -43,8 +43,7 @@ static void usage(FILE *f) {
 
 enum { OPT_SOCKET = SC_CLI_OPT_OWN };
 
-static const struct option long_options[] = {
-    SC_CLI_JOB_LONG_OPTIONS,
+static const struct option own_options[] = {
     {"socket", required_argument, NULL, OPT_SOCKET},
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
@@ -82,52 +81,51 @@ static int64_t value_i64(const sc_client_mesh_t *m, const char *name) {
   return v->kind == SC_CLIENT_F64 ? (int64_t)v->v.f : v->v.i;
 }
 
-/* The daemon's diagnostics (PROTOCOL.md 6.12) as the core reports them. */
+/* One element of a diagnostic, from the value of its wire name. */
+static void diag_element(const sc_client_mesh_t *m, const sc_diag_info_t *row,
+                         const char *name, void *field, size_t i) {
+  switch (row->kind) {
+  case SC_DIAG_COUNT:
+  case SC_DIAG_LOOPS:
+    ((uint64_t *)field)[i] = value_u64(m, name);
+    break;
+  case SC_DIAG_BOOL:
+    *(int *)field = value_u64(m, name) != 0;
+    break;
+  case SC_DIAG_PATH:
+    *(int *)field = (int)value_u64(m, name);
+    break;
+  case SC_DIAG_INT:
+    *(int64_t *)field = value_i64(m, name);
+    break;
+  case SC_DIAG_SECONDS:
+  case SC_DIAG_STAGE_SECONDS:
+    ((double *)field)[i] =
+        sc_client_value_get(m->values, m->value_count, name, 0);
+    break;
+  }
+}
+
+/* The daemon's diagnostics (PROTOCOL.md 6.12) as the core reports them,
+ * read by the names of the core's table. */
 static void diag_from_values(const sc_client_mesh_t *m, sc_diag_t *d) {
   memset(d, 0, sizeof *d);
-#define U_(field) d->field = value_u64(m, #field)
-  U_(points_in);
-  U_(duplicates_merged);
-  U_(delaunay_vertices);
-  U_(delaunay_cells);
-  U_(delaunay_facets);
-  U_(hull_vertices);
-  U_(degenerate_cells);
-  U_(candidates);
-  U_(pruned);
-  U_(triangles);
-  U_(walk_rejected);
-  U_(holes_filled);
-  U_(hole_triangles);
-  U_(samples_unused);
-  U_(boundary_edges);
-  U_(boundary_loops);
-  U_(nonmanifold_edges);
-  U_(nonmanifold_vertices);
-  U_(components);
-  U_(closed_components);
-  U_(boundary_samples);
-  U_(longest_loop);
-  U_(cells_relabelled);
-  U_(bubbles_dropped);
-  U_(samples_attached);
-  U_(handles_cut);
-#undef U_
-  d->path = (int)value_u64(m, "path");
-  d->loops_by_length[0] = value_u64(m, "loops.3_10");
-  d->loops_by_length[1] = value_u64(m, "loops.11_100");
-  d->loops_by_length[2] = value_u64(m, "loops.101_1000");
-  d->loops_by_length[3] = value_u64(m, "loops.over_1000");
-  d->closed = value_u64(m, "closed") != 0;
-  d->euler = value_i64(m, "euler");
-  d->genus = value_i64(m, "genus");
-  char name[64];
-  for (int s = 0; s < SC_STAGE_COUNT; ++s) {
-    snprintf(name, sizeof name, "seconds.%s", sc_stage_name(s));
-    d->seconds[s] = sc_client_value_get(m->values, m->value_count, name, 0);
+  size_t n;
+  const sc_diag_info_t *rows = sc_diag_table(&n);
+  for (size_t r = 0; r < n; ++r) {
+    void *field = (char *)d + rows[r].offset;
+    if (rows[r].kind != SC_DIAG_STAGE_SECONDS &&
+        rows[r].kind != SC_DIAG_LOOPS) {
+      diag_element(m, &rows[r], rows[r].wire, field, 0);
+      continue;
+    }
+    for (size_t i = 0; i < rows[r].count; ++i) {
+      char name[64];
+      snprintf(name, sizeof name, "%s.%s", rows[r].wire,
+               sc_diag_element_name(&rows[r], i));
+      diag_element(m, &rows[r], name, field, i);
+    }
   }
-  d->seconds_total =
-      sc_client_value_get(m->values, m->value_count, "seconds.total", 0);
   /* What the counts must be whatever the daemon chose to send. */
   if (!sc_client_value_find(m->values, m->value_count, "points_in"))
     d->points_in = m->point_count;
@@ -142,9 +140,16 @@ int sc_cmd_submit(int argc, char **argv) {
   o.params.threads = 1;
   const char *socket_path = NULL;
 
+  sc_cli_getopt_t g;
+  if (sc_cli_job_getopt(&g, 0, own_options, "h") < 0) {
+    sc_cli_error("submit: too many options");
+    return SC_EXIT_FAILURE;
+  }
+
   opterr = 0;
   int c;
-  while ((c = getopt_long(argc, argv, ":o:m:qh", long_options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, g.short_options, g.long_options,
+                          NULL)) != -1) {
     int shared = sc_cli_job_option(&o, c, optarg);
     if (shared < 0)
       return SC_EXIT_USAGE;
@@ -165,17 +170,6 @@ int sc_cmd_submit(int argc, char **argv) {
     return SC_EXIT_USAGE;
   params = o.params;
   const char *in_path = o.in_path, *out_path = o.out_path;
-  /* Checked here, before any file or the daemon is touched, and worded as
-   * `reconstruct` words them. */
-  if (!(params.r > 0 && params.r < 0.5)) {
-    sc_cli_error("submit: r must be in (0, 0.5), got %g", params.r);
-    return SC_EXIT_USAGE;
-  }
-  if (!(params.cocone_theta > 0 && params.cocone_theta < SC_PI / 2)) {
-    sc_cli_error("submit: cocone_theta must be in (0, pi/2), got %g",
-                 params.cocone_theta);
-    return SC_EXIT_USAGE;
-  }
 
   sc_cli_progress_t progress;
   sc_mesh_format_t fmt;
@@ -207,14 +201,19 @@ int sc_cmd_submit(int argc, char **argv) {
    * daemon's. */
   sc_params_t dflt;
   sc_params_init(&dflt);
-  if (params.max_hole_edges != dflt.max_hole_edges)
-    cp.max_hole_edges = params.max_hole_edges;
-  if (params.boundary_rho != dflt.boundary_rho)
-    cp.boundary_rho = params.boundary_rho;
-  if (params.boundary_alpha != dflt.boundary_alpha)
-    cp.boundary_alpha = params.boundary_alpha;
-  cp.paper_pruning = params.paper_pruning;
-  cp.watertight_labels = params.watertight_labels;
+#define SUBMIT_OPTION_OPTION(field)                                            \
+  if (params.field != dflt.field)                                              \
+    cp.field = params.field;
+#define SUBMIT_OPTION_FIXED(field)
+#define SUBMIT_OPTION_LOCAL(field)
+#define SUBMIT_OPTION_(field, type, kind, dflt_, lo, hi, range, text, wire,    \
+                       ...)                                                    \
+  SUBMIT_OPTION_##wire(field)
+  SC_PARAM_MAP(SUBMIT_OPTION_)
+#undef SUBMIT_OPTION_
+#undef SUBMIT_OPTION_LOCAL
+#undef SUBMIT_OPTION_FIXED
+#undef SUBMIT_OPTION_OPTION
   /* As doubles, so that the file gets what the local command writes. */
   cp.normals = o.normals;
   cp.progress = show_progress;

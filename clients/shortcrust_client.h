@@ -41,6 +41,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* The core's tables of modes and parameters (header only: the client
+ * library does not link the core). */
+#include "shortcrust.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -86,13 +90,13 @@ const char *sc_client_err_name(int code);
  * "DEGENERATE_INPUT"; "UNKNOWN" for codes this version does not know. */
 const char *sc_client_server_code_name(uint32_t code);
 
-/* Candidate tests, numbered as in the core and on the wire (PROTOCOL.md
- * section 4). A daemon may refuse the last three with UNSUPPORTED. */
-#define SC_CLIENT_MODE_SHORTCRUST 0
-#define SC_CLIENT_MODE_COCONE 1
-#define SC_CLIENT_MODE_BOUNDARY 2
-#define SC_CLIENT_MODE_WATERTIGHT 3
-#define SC_CLIENT_MODE_AUTO 4
+/* Candidate tests: the core's modes (SC_MODE_MAP), numbered as on the wire
+ * (PROTOCOL.md section 4). */
+#define SC_CLIENT_MODE_SHORTCRUST SC_MODE_SHORTCRUST
+#define SC_CLIENT_MODE_COCONE SC_MODE_COCONE
+#define SC_CLIENT_MODE_BOUNDARY SC_MODE_BOUNDARY
+#define SC_CLIENT_MODE_WATERTIGHT SC_MODE_WATERTIGHT
+#define SC_CLIENT_MODE_AUTO SC_MODE_AUTO
 
 /* Stages of a job for the progress callback: the daemon's six, numbered as
  * in the core (0 input ... 5 extract), and the client's own two. */
@@ -220,22 +224,23 @@ typedef struct sc_client_params {
   double theta;
   /* Non-zero: have the daemon send one normal per point (as doubles). */
   int normals;
-  /* Job options (PROTOCOL.md 6.3), sent only when not left at these
-   * "daemon's default" values, and only to a daemon that takes them (see
-   * sc_client_info_t.job_options; a daemon that does not gets no job: it
-   * ends SC_CLIENT_EREFUSED at once, with code UNSUPPORTED). Ranges and
-   * meanings as in sc_params_t of the core.
-   * Holes closed after extraction, at most this many edges; 0 never; -1
-   * (default) the daemon's default, 100. */
-  int max_hole_edges;
-  /* Boundary detection: in (0, 10] and (0, pi/2] radians; 0 (default)
-   * the daemon's defaults, 1.3 and pi/9. */
-  double boundary_rho;
-  double boundary_alpha;
-  /* 1: the paper's pruning; 1: watertight mode labels cells first.
-   * Default 0 for both, as on the daemon. */
-  int paper_pruning;
-  int watertight_labels;
+  /* Job options (PROTOCOL.md 6.3): one field per row of the core's
+   * parameter table (SC_PARAM_MAP in shortcrust.h) that travels as an
+   * option, with that row's name, type, range and meaning, in its order:
+   * today paper_pruning, max_hole_edges, boundary_rho (in (0, 10]),
+   * boundary_alpha (in (0, pi/2] radians) and watertight_labels. Each is
+   * sent only when not left at its "daemon's default" value, which
+   * sc_client_params_init() sets: -1 for an integer, 0 for a number or a
+   * flag. A daemon that does not take job options gets no job: it ends
+   * SC_CLIENT_EREFUSED at once, with code UNSUPPORTED (see
+   * sc_client_info_t.job_options). */
+#define SC_CLIENT_PARAM_FIELD_OPTION(field, type) type field;
+#define SC_CLIENT_PARAM_FIELD_FIXED(field, type)
+#define SC_CLIENT_PARAM_FIELD_LOCAL(field, type)
+#define SC_CLIENT_PARAM_FIELD_(field, type, kind, dflt, lo, hi, range, text,  \
+                               wire, ...)                                      \
+  SC_CLIENT_PARAM_FIELD_##wire(field, type)
+  SC_PARAM_MAP(SC_CLIENT_PARAM_FIELD_)
   /* Optional. */
   sc_client_progress_fn progress;
   void *progress_user;

@@ -44,25 +44,30 @@ extern "C" const char *sc_err_name(int code) {
 }
 
 extern "C" const char *sc_stage_name(int stage) {
-  static const char *const names[SC_STAGE_COUNT] = {
-      "input", "delaunay", "poles", "candidates", "prune", "extract"};
-  if (stage < 0 || stage >= SC_STAGE_COUNT)
-    return "?";
-  return names[stage];
+  switch (stage) {
+#define SC_STAGE_NAME_(name, value, str, what)                                 \
+  case value:                                                                  \
+    return str;
+    SC_STAGE_MAP(SC_STAGE_NAME_)
+#undef SC_STAGE_NAME_
+  }
+  return "?";
+}
+
+extern "C" const char *sc_mode_name(int mode) {
+  switch (mode) {
+#define SC_MODE_NAME_(name, value, str)                                        \
+  case value:                                                                  \
+    return str;
+    SC_MODE_MAP(SC_MODE_NAME_)
+#undef SC_MODE_NAME_
+  }
+  return "?";
 }
 
 extern "C" void sc_params_init(sc_params_t *p) {
-  if (!p)
-    return;
-  std::memset(p, 0, sizeof *p);
-  p->mode = SC_MODE_COCONE;
-  p->r = 0.18;
-  p->cocone_theta = M_PI / 8;
-  p->paper_pruning = 0;
-  p->max_hole_edges = 100;
-  p->threads = 1;
-  p->boundary_rho = sc::kDefaultRho;
-  p->boundary_alpha = sc::kDefaultAlpha;
+  if (p)
+    *p = sc::kDefaultParams;
 }
 
 extern "C" int sc_params_check(const sc_params_t *p, char *msg,
@@ -75,11 +80,14 @@ extern "C" int sc_params_check(const sc_params_t *p, char *msg,
 }
 
 extern "C" const char *sc_path_name(int path) {
-  static const char *const names[SC_PATH_COUNT_] = {
-      "shortcrust", "cocone", "boundary", "watertight", "watertight-fill"};
-  if (path < 0 || path >= SC_PATH_COUNT_)
-    return "?";
-  return names[path];
+  switch (path) {
+#define SC_PATH_NAME_(name, value, str)                                        \
+  case value:                                                                  \
+    return str;
+    SC_PATH_MAP(SC_PATH_NAME_)
+#undef SC_PATH_NAME_
+  }
+  return "?";
 }
 
 namespace sc {
@@ -93,53 +101,42 @@ void set_msg(char *msg, size_t len, const char *fmt, ...) {
   va_end(ap);
 }
 
-int check_params(const sc_params_t *p, char *msg, size_t len) {
-  // A C caller may store any int in the enum; in C++ loading a value
-  // outside the enum's range is undefined, so look at the bytes.
+// The value of a field as a number, for the range checks: a C caller may
+// store any int in the enum, and in C++ loading a value outside the enum's
+// range is undefined, so the mode is read from its bytes.
+static double as_number(const sc_mode_t &mode) {
   static_assert(sizeof(sc_mode_t) == sizeof(int), "mode is an int");
-  int mode;
-  std::memcpy(&mode, &p->mode, sizeof mode);
-  if (mode < 0 || mode >= SC_MODE_COUNT_) {
-    set_msg(msg, len, "unknown mode %d", mode);
-    return SC_EINVALID_ARGUMENT;
+  int v;
+  std::memcpy(&v, &mode, sizeof v);
+  return v;
+}
+static double as_number(double v) { return v; }
+static double as_number(int v) { return v; }
+
+// The message for a field out of range, worded per kind.
+static void range_msg(char *msg, size_t len, const char *kind,
+                      const char *field, const char *text, int range,
+                      double v) {
+  const char *zero = (range & SC_RANGE_ZERO_DEFAULT) ? " or 0" : "";
+  if (std::strcmp(kind, "MODE") == 0)
+    set_msg(msg, len, "unknown mode %d", (int)v);
+  else if (std::strcmp(kind, "INT") == 0 || std::strcmp(kind, "FLAG") == 0)
+    set_msg(msg, len, "%s must be %s%s, got %d", field, text, zero, (int)v);
+  else
+    set_msg(msg, len, "%s must be %s%s, got %g", field, text, zero, v);
+}
+
+int check_params(const sc_params_t *p, char *msg, size_t len) {
+#define SC_CHECK_(field, type, kind, dflt, lo, hi, range, text, ...)           \
+  {                                                                            \
+    double v = as_number(p->field);                                            \
+    if (!SC_IN_RANGE(v, (double)(lo), (double)(hi), range)) {                  \
+      range_msg(msg, len, #kind, #field, text, range, v);                      \
+      return SC_EINVALID_ARGUMENT;                                             \
+    }                                                                          \
   }
-  if (!(p->r > 0 && p->r < 0.5)) {
-    set_msg(msg, len, "r must be in (0, 0.5), got %g", p->r);
-    return SC_EINVALID_ARGUMENT;
-  }
-  if (!(p->cocone_theta > 0 && p->cocone_theta < M_PI / 2)) {
-    set_msg(msg, len, "cocone_theta must be in (0, pi/2), got %g",
-            p->cocone_theta);
-    return SC_EINVALID_ARGUMENT;
-  }
-  if (p->paper_pruning != 0 && p->paper_pruning != 1) {
-    set_msg(msg, len, "paper_pruning must be 0 or 1, got %d", p->paper_pruning);
-    return SC_EINVALID_ARGUMENT;
-  }
-  if (p->max_hole_edges < 0 || p->max_hole_edges > 100000) {
-    set_msg(msg, len, "max_hole_edges must be in [0, 100000], got %d",
-            p->max_hole_edges);
-    return SC_EINVALID_ARGUMENT;
-  }
-  if (!(p->boundary_rho >= 0 && p->boundary_rho <= 10)) {
-    set_msg(msg, len, "boundary_rho must be in (0, 10] or 0, got %g",
-            p->boundary_rho);
-    return SC_EINVALID_ARGUMENT;
-  }
-  if (!(p->boundary_alpha >= 0 && p->boundary_alpha <= M_PI / 2)) {
-    set_msg(msg, len, "boundary_alpha must be in (0, pi/2] or 0, got %g",
-            p->boundary_alpha);
-    return SC_EINVALID_ARGUMENT;
-  }
-  if (p->watertight_labels != 0 && p->watertight_labels != 1) {
-    set_msg(msg, len, "watertight_labels must be 0 or 1, got %d",
-            p->watertight_labels);
-    return SC_EINVALID_ARGUMENT;
-  }
-  if (p->threads < 0) {
-    set_msg(msg, len, "threads must be >= 0, got %d", p->threads);
-    return SC_EINVALID_ARGUMENT;
-  }
+  SC_PARAM_MAP(SC_CHECK_)
+#undef SC_CHECK_
   return SC_OK;
 }
 

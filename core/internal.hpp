@@ -23,10 +23,18 @@ namespace sc {
 // triangulation dominates); used for admission control by the daemon.
 constexpr uint64_t kBytesPerPoint = 1100;
 
+// The defaults of the parameter table in shortcrust.h, in its order.
+constexpr sc_params_t kDefaultParams = {
+#define SC_PARAM_DEFAULT_(field, type, kind, dflt, ...) type(dflt),
+    SC_PARAM_MAP(SC_PARAM_DEFAULT_)
+#undef SC_PARAM_DEFAULT_
+        nullptr,
+    nullptr};
+
 // Defaults of the boundary detection (see the README for the measurements
 // behind them); a parameter of 0 stands for these.
-constexpr double kDefaultRho = 1.3;
-constexpr double kDefaultAlpha = M_PI / 9; // 20 degrees
+constexpr double kDefaultRho = kDefaultParams.boundary_rho;
+constexpr double kDefaultAlpha = kDefaultParams.boundary_alpha;
 
 // An error with a code from the public table, thrown inside the core and
 // turned into a return value at the C boundary.

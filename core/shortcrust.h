@@ -48,44 +48,62 @@ const char *sc_strerror(int code);
 /* The code's name without the prefix, e.g. "NONFINITE"; "UNKNOWN" otherwise. */
 const char *sc_err_name(int code);
 
-/* Candidate selection (ALGORITHM.md section 3, and section 6 for the rest). */
+/* Candidate selection (ALGORITHM.md section 3, and section 6 for the rest).
+ * One row per mode: X(NAME, value, name): the numbering is the wire
+ * protocol's too (proto/PROTOCOL.md section 4), and the name is how the
+ * command line, reports and logs spell the mode.
+ *  - SHORTCRUST: the paper's two criteria (normal and small ball) with
+ *    parameter r.
+ *  - COCONE: the cocone test: the dual Voronoi edge meets the cocone of all
+ *    three vertices.
+ *  - BOUNDARY: for scans with a boundary (ALGORITHM.md section 6): samples
+ *    are sorted into interior and boundary ones (Dey and Giesen's ratio and
+ *    normal tests, parameters boundary_rho and boundary_alpha); the cocone
+ *    test is made only at interior vertices, and no edge at a boundary
+ *    sample is pruned, so the output is a 2-manifold with boundary.
+ *  - WATERTIGHT: boundary mode, then every hole is closed: handles that
+ *    closed round a hole are cut, each boundary loop gets a least-area
+ *    patch, and where the patches cannot close the surface the Delaunay
+ *    cells are labelled inside or outside across it and the boundary of the
+ *    inside cells is taken. The output is a closed 2-manifold. When most
+ *    samples are found not interior (too sparse to tell a boundary from
+ *    undersampling), the input is taken as closed, as in auto mode: the
+ *    cocone test everywhere, and no handle cut.
+ *  - AUTO: for input not known to be closed: the cocone test where the
+ *    samples look like a closed surface, boundary mode where they do not
+ *    (diag.path says which was taken). */
+#define SC_MODE_MAP(X)                                                         \
+  X(SHORTCRUST, 0, "shortcrust")                                               \
+  X(COCONE, 1, "cocone")                                                       \
+  X(BOUNDARY, 2, "boundary")                                                   \
+  X(WATERTIGHT, 3, "watertight")                                               \
+  X(AUTO, 4, "auto")
+
 typedef enum sc_mode {
-  /* The paper's two criteria (normal and small ball) with parameter r. */
-  SC_MODE_SHORTCRUST = 0,
-  /* The cocone test: the dual Voronoi edge meets the cocone of all three
-   * vertices. */
-  SC_MODE_COCONE = 1,
-  /* For scans with a boundary (ALGORITHM.md section 6): samples are sorted
-   * into interior and boundary ones (Dey and Giesen's ratio and normal
-   * tests, parameters boundary_rho and boundary_alpha); the cocone test is
-   * made only at interior vertices, and no edge at a boundary sample is
-   * pruned, so the output is a 2-manifold with boundary. */
-  SC_MODE_BOUNDARY = 2,
-  /* Boundary mode, then every hole is closed: handles that closed round a
-   * hole are cut, each boundary loop gets a least-area patch, and where
-   * the patches cannot close the surface the Delaunay cells are labelled
-   * inside or outside across it and the boundary of the inside cells is
-   * taken. The output is a closed 2-manifold. When most samples are
-   * found not interior (too sparse to tell a boundary from
-   * undersampling), the input is taken as closed, as in auto mode: the
-   * cocone test everywhere, and no handle cut. */
-  SC_MODE_WATERTIGHT = 3,
-  /* For input not known to be closed: the cocone test where the samples
-   * look like a closed surface, boundary mode where they do not (diag.path
-   * says which was taken). */
-  SC_MODE_AUTO = 4,
+#define SC_MODE_ENUM_(name, value, str) SC_MODE_##name = (value),
+  SC_MODE_MAP(SC_MODE_ENUM_)
+#undef SC_MODE_ENUM_
   /* Count of modes; not a mode. */
   SC_MODE_COUNT_
 } sc_mode_t;
 
-/* The stages of a reconstruction, in the order they run. */
+/* The name of a mode ("cocone", ...); "?" when out of range. */
+const char *sc_mode_name(int mode);
+
+/* The stages of a reconstruction, in the order they run:
+ * X(NAME, value, name, what runs). Numbered as on the wire. */
+#define SC_STAGE_MAP(X)                                                        \
+  X(INPUT, 0, "input", "validation, duplicate detection")                      \
+  X(DELAUNAY, 1, "delaunay", "the 3D Delaunay triangulation")                  \
+  X(POLES, 2, "poles", "Voronoi vertices and poles")                           \
+  X(CANDIDATES, 3, "candidates", "one pass over the Delaunay facets")          \
+  X(PRUNE, 4, "prune", "sharp-edge pruning")                                   \
+  X(EXTRACT, 5, "extract", "manifold extraction and orientation")
+
 typedef enum sc_stage {
-  SC_STAGE_INPUT = 0,      /* validation, duplicate detection */
-  SC_STAGE_DELAUNAY = 1,   /* the 3D Delaunay triangulation */
-  SC_STAGE_POLES = 2,      /* Voronoi vertices and poles */
-  SC_STAGE_CANDIDATES = 3, /* one pass over the Delaunay facets */
-  SC_STAGE_PRUNE = 4,      /* sharp-edge pruning */
-  SC_STAGE_EXTRACT = 5,    /* manifold extraction and orientation */
+#define SC_STAGE_ENUM_(name, value, str, what) SC_STAGE_##name = (value),
+  SC_STAGE_MAP(SC_STAGE_ENUM_)
+#undef SC_STAGE_ENUM_
   SC_STAGE_COUNT = 6
 } sc_stage_t;
 
@@ -101,114 +119,286 @@ const char *sc_stage_name(int stage);
  */
 typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
 
+/* pi, for the angles below and for every module that converts them. */
+#define SC_PI 3.14159265358979323846
+
+/*
+ * The parameters of a reconstruction, one row each; sc_params_t, its
+ * defaults (sc_params_init) and checks (sc_params_check), the command
+ * line's options and --help lines, the report, the daemon's decoding of job
+ * options and the client library's checks are all made from this table.
+ *
+ *   X(field, type, kind, default, lo, hi, range, range_text, wire,
+ *     short_opt, long_opt, metavar, help)
+ *
+ * kind: MODE (an sc_mode_t), REAL, ANGLE (radians; degrees on the command
+ * line), INT, FLAG (0 or 1; an option without a value).
+ * lo, hi, range: the valid values; range is a mask of SC_RANGE_* below,
+ * and range_text says the same in words for messages (angles in radians).
+ * wire: FIXED (a field of JOB_BEGIN, proto/PROTOCOL.md section 6.3),
+ * OPTION (a job option of that name and of kind u64 for INT and FLAG, f64
+ * for REAL and ANGLE), or LOCAL (not sent to the daemon).
+ * short_opt, long_opt, metavar: the command line's spelling (0 or NULL for
+ * none); help: the meaning, in one sentence without the default.
+ *
+ * Why the defaults are what they are: the README, "Parameters".
+ *  - mode: the candidate test (sc_mode_t above).
+ *  - r: sampling parameter of the shortcrust criteria. The paper proves its
+ *    guarantees for r < 1/7; larger values accept more triangles on sparser
+ *    or less even samples, and from about 0.2 on bridge nearby parts of a
+ *    surface. Ignored by the cocone test.
+ *  - cocone_theta: half-width of the cocone around the plane normal to the
+ *    pole: the cocone is |cos angle(y - s, pole)| <= cos(pi/2 - theta).
+ *  - paper_pruning: edges with a single candidate triangle. 0: such an edge
+ *    is sharp only when its triangle hangs by it alone (two or more of its
+ *    edges have no other candidate), so fins go but a hole left by a
+ *    missing triangle stays small. 1: every such edge is sharp, exactly as
+ *    in the paper; one missing triangle then erodes the whole surface.
+ *  - max_hole_edges: holes whose boundary loop has at most this many edges
+ *    are closed after extraction by a least-area triangulation of the loop;
+ *    0 disables.
+ *  - threads: threads of the Delaunay triangulation; 0 means one per core.
+ *  - boundary_rho (boundary, watertight and auto modes): a sample passes
+ *    the ratio test when the farthest Voronoi vertex of its cell inside its
+ *    cocone is at most boundary_rho times the distance to its negative
+ *    pole. 0 means the default, so that a caller written before this field
+ *    existed keeps working; so for boundary_alpha.
+ *  - boundary_alpha: poles of neighbouring interior samples agree when the
+ *    angle between them (unoriented) is at most this.
+ *  - watertight_labels: 0 closes the holes with least-area patches and
+ *    labels the Delaunay cells only where the patches cannot close the
+ *    surface; 1 labels the cells first (inside or outside across the
+ *    surface; the output is the boundary of the inside cells) and patches
+ *    only when no cell comes out inside.
+ */
+#define SC_RANGE_CLOSED 0      /* lo <= v <= hi */
+#define SC_RANGE_LO_OPEN 1     /* lo < v */
+#define SC_RANGE_HI_OPEN 2     /* v < hi */
+#define SC_RANGE_ZERO_DEFAULT 4 /* 0 is valid too, and means the default */
+#define SC_RANGE_OPEN (SC_RANGE_LO_OPEN | SC_RANGE_HI_OPEN)
+
+#define SC_PARAM_MAP(X)                                                        \
+  X(mode, sc_mode_t, MODE, SC_MODE_COCONE, 0, SC_MODE_COUNT_ - 1,              \
+    SC_RANGE_CLOSED, "a mode", FIXED, 'm', "mode", "MODE",                     \
+    "cocone, shortcrust, boundary (scans with a boundary), watertight "       \
+    "(close every hole) or auto")                                              \
+  X(r, double, REAL, 0.18, 0, 0.5, SC_RANGE_OPEN, "in (0, 0.5)", FIXED, 0,     \
+    "r", "R", "shortcrust sampling parameter")                                 \
+  X(cocone_theta, double, ANGLE, SC_PI / 8, 0, SC_PI / 2, SC_RANGE_OPEN,       \
+    "in (0, pi/2)", FIXED, 0, "theta", "DEG", "cocone half-width")             \
+  X(paper_pruning, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION, 0,   \
+    "paper-pruning", NULL,                                                     \
+    "prune every edge with a single candidate, as in the paper")               \
+  X(max_hole_edges, int, INT, 100, 0, 100000, SC_RANGE_CLOSED,                 \
+    "in [0, 100000]", OPTION, 0, "max-hole", "N",                              \
+    "close holes of at most N edges, 0 = never")                               \
+  X(threads, int, INT, 1, 0, 1024, SC_RANGE_CLOSED, "in [0, 1024]", LOCAL,     \
+    'j', "threads", "N",                                                       \
+    "threads for the Delaunay triangulation, 0 = one per core")                \
+  X(boundary_rho, double, REAL, 1.3, 0, 10,                                    \
+    SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "in (0, 10]", OPTION, 0, "rho",  \
+    "RHO", "boundary detection: ratio of cocone extent to pole height")        \
+  X(boundary_alpha, double, ANGLE, SC_PI / 9, 0, SC_PI / 2,                    \
+    SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "in (0, pi/2]", OPTION, 0,       \
+    "alpha", "DEG",                                                            \
+    "boundary detection: largest angle between neighbouring poles")            \
+  X(watertight_labels, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION,  \
+    0, "labels", NULL,                                                         \
+    "watertight mode: close the surface by labelling Delaunay cells inside "  \
+    "or outside first (default: least-area patches first, labelling where "   \
+    "they cannot close it)")
+
 typedef struct sc_params {
-  /* Candidate test. Default SC_MODE_COCONE. */
-  sc_mode_t mode;
-  /* Sampling parameter of the shortcrust criteria, in (0, 0.5). The paper
-   * proves its guarantees for r < 1/7; larger values accept more triangles
-   * on sparser or less even samples, and from about 0.2 on bridge nearby
-   * parts of a surface. Default 0.18 (see the README for the measurements
-   * behind it). Ignored by the cocone test. */
-  double r;
-  /* Half-width of the cocone around the plane normal to the pole, radians,
-   * in (0, pi/2). Default pi/8: the cocone is |cos angle(y - s, pole)| <=
-   * cos(pi/2 - theta). */
-  double cocone_theta;
-  /* Edges with a single candidate triangle. 0 (default): such an edge is
-   * sharp only when its triangle hangs by it alone (two or more of its edges
-   * have no other candidate), so fins go but a hole left by a missing
-   * triangle stays small. 1: every such edge is sharp, exactly as in the
-   * paper; one missing triangle then erodes the whole surface. */
-  int paper_pruning;
-  /* Holes whose boundary loop has at most this many edges are closed after
-   * extraction by a least-area triangulation of the loop; 0 disables. In
-   * [0, 100000]. Default 100. */
-  int max_hole_edges;
-  /* Threads for the Delaunay triangulation; 0 means one per core.
-   * Default 1. */
-  int threads;
+#define SC_PARAM_FIELD_(field, type, ...) type field;
+  SC_PARAM_MAP(SC_PARAM_FIELD_)
+#undef SC_PARAM_FIELD_
   /* Optional progress and cancellation; NULL for none. */
   sc_progress_fn progress;
   void *progress_user;
-  /* Boundary detection (boundary, watertight and auto modes). A sample
-   * passes the ratio test when the farthest Voronoi vertex of its cell
-   * inside its cocone is at most boundary_rho times the distance to its
-   * negative pole; in (0, 10], default 1.3; 0 means the default (so that a
-   * caller written before this field existed keeps working). */
-  double boundary_rho;
-  /* Poles of neighbouring interior samples agree when the angle between
-   * them (unoriented) is at most this, radians, in (0, pi/2]; default
-   * pi/9 (20 degrees); 0 means the default. */
-  double boundary_alpha;
-  /* Watertight mode: 0 (default) closes the holes with least-area patches
-   * and labels the Delaunay cells only where the patches cannot close the
-   * surface; 1 labels the cells first (inside or outside across the
-   * surface; the output is the boundary of the inside cells) and patches
-   * only when no cell comes out inside. */
-  int watertight_labels;
 } sc_params_t;
 
-/* Fills *p with the documented defaults. */
+/* Whether v lies in a row's range (lo, hi and the SC_RANGE_ mask). */
+#define SC_IN_RANGE(v, lo, hi, range)                                          \
+  ((((range)&SC_RANGE_ZERO_DEFAULT) && (v) == 0) ||                            \
+   ((((range)&SC_RANGE_LO_OPEN) ? (v) > (lo) : (v) >= (lo)) &&                 \
+    (((range)&SC_RANGE_HI_OPEN) ? (v) < (hi) : (v) <= (hi))))
+
+/* The parameter table as data, for programs that walk it (the command
+ * line, the daemon, reports): sc_param_table() returns its rows in order and
+ * sets *count. */
+typedef enum sc_param_kind {
+  SC_PARAM_MODE,
+  SC_PARAM_REAL,
+  SC_PARAM_ANGLE,
+  SC_PARAM_INT,
+  SC_PARAM_FLAG
+} sc_param_kind_t;
+typedef enum sc_param_wire {
+  SC_PARAM_FIXED,
+  SC_PARAM_OPTION,
+  SC_PARAM_LOCAL
+} sc_param_wire_t;
+typedef struct sc_param_info {
+  const char *name;       /* the field's name, and the job option's */
+  sc_param_kind_t kind;
+  size_t offset;          /* of the field in sc_params_t */
+  double dflt, lo, hi;    /* as numbers (a mode's value) */
+  int range;              /* SC_RANGE_ mask */
+  const char *range_text; /* "in (0, 0.5)" */
+  sc_param_wire_t wire;
+  int short_opt;          /* 0 for none */
+  const char *long_opt;   /* NULL for none */
+  const char *metavar;    /* NULL for an option without a value */
+  const char *help;
+} sc_param_info_t;
+const sc_param_info_t *sc_param_table(size_t *count);
+
+/* Fills *p with the defaults of the table above. */
 void sc_params_init(sc_params_t *p);
-/* Checks every field of *p against the ranges documented above, as
+/* Checks every field of *p against the ranges of the table above, as
  * sc_reconstruct() does: SC_OK, or SC_EINVALID_ARGUMENT with the reason
  * in msg (when msg is not NULL). */
 int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
 
-/* Diagnostics of one reconstruction (ALGORITHM.md section 7). */
+/* Boundary loops are counted by length in edges, in these bins:
+ * X(index, wire suffix, least, most); most 0 for no upper bound. */
+#define SC_LOOP_BIN_MAP(X)                                                     \
+  X(0, "3_10", 3, 10)                                                          \
+  X(1, "11_100", 11, 100)                                                      \
+  X(2, "101_1000", 101, 1000)                                                  \
+  X(3, "over_1000", 1001, 0)
+#define SC_LOOP_BINS 4
+
+/*
+ * Diagnostics of one reconstruction (ALGORITHM.md section 7), one row each:
+ * sc_diag_t, the report (`--report`), the daemon's JOB_DONE values
+ * (proto/PROTOCOL.md section 6.12) and the command's reading of them are
+ * made from this table.
+ *
+ *   X(field, type, dim, kind, wire, help)
+ *
+ * kind: COUNT (uint64_t), BOOL (int, 0 or 1; u64 on the wire), INT
+ * (int64_t), PATH (int, an sc_path_t; u64 on the wire, its name in the
+ * report), STAGE_SECONDS (double per stage; on the wire "wire.STAGE", with
+ * the names of sc_stage_name()), SECONDS (double), LOOPS (uint64_t per bin
+ * of SC_LOOP_BIN_MAP; on the wire "wire.SUFFIX"). wire: the name in JOB_DONE
+ * (the prefix, for the two arrays). The report names each field as the
+ * struct does; its seconds make an object of their own.
+ */
+#define SC_DIAG_MAP(X)                                                         \
+  X(points_in, uint64_t, , COUNT, "points_in", "points given")                 \
+  X(duplicates_merged, uint64_t, , COUNT, "duplicates_merged",                 \
+    "exact duplicates of an earlier point")                                    \
+  X(delaunay_vertices, uint64_t, , COUNT, "delaunay_vertices",                 \
+    "distinct points in the triangulation")                                    \
+  X(delaunay_cells, uint64_t, , COUNT, "delaunay_cells", "finite tetrahedra")  \
+  X(delaunay_facets, uint64_t, , COUNT, "delaunay_facets",                     \
+    "finite triangles")                                                        \
+  X(hull_vertices, uint64_t, , COUNT, "hull_vertices",                         \
+    "samples on the convex hull")                                              \
+  X(degenerate_cells, uint64_t, , COUNT, "degenerate_cells",                   \
+    "flat cells whose circumcentre was guarded")                               \
+  X(candidates, uint64_t, , COUNT, "candidates",                               \
+    "triangles passing the candidate test")                                    \
+  X(pruned, uint64_t, , COUNT, "pruned",                                       \
+    "candidates removed for a sharp edge")                                     \
+  X(triangles, uint64_t, , COUNT, "triangles", "triangles in the output")      \
+  X(walk_rejected, uint64_t, , COUNT, "walk_rejected",                         \
+    "survivors of pruning left out by the walk")                               \
+  X(holes_filled, uint64_t, , COUNT, "holes_filled",                           \
+    "small holes closed after the walk")                                       \
+  X(hole_triangles, uint64_t, , COUNT, "hole_triangles",                       \
+    "triangles added to close them")                                           \
+  X(samples_unused, uint64_t, , COUNT, "samples_unused",                       \
+    "distinct samples in no output triangle")                                  \
+  X(boundary_edges, uint64_t, , COUNT, "boundary_edges",                       \
+    "output edges with a single triangle")                                     \
+  X(boundary_loops, uint64_t, , COUNT, "boundary_loops",                       \
+    "closed loops of boundary edges")                                          \
+  X(nonmanifold_edges, uint64_t, , COUNT, "nonmanifold_edges",                 \
+    "always 0 on success; kept as a check")                                    \
+  X(nonmanifold_vertices, uint64_t, , COUNT, "nonmanifold_vertices",           \
+    "always 0 on success; kept as a check")                                    \
+  X(components, uint64_t, , COUNT, "components",                               \
+    "edge-connected components of the output")                                 \
+  X(closed_components, uint64_t, , COUNT, "closed_components",                 \
+    "components without boundary")                                             \
+  X(closed, int, , BOOL, "closed",                                             \
+    "1 when the whole output has no boundary, else 0")                         \
+  X(euler, int64_t, , INT, "euler", "V - E + F over the used vertices")        \
+  X(genus, int64_t, , INT, "genus",                                            \
+    "sum of the genera of the closed components")                              \
+  X(seconds, double, [SC_STAGE_COUNT], STAGE_SECONDS, "seconds",               \
+    "wall time of each stage, in seconds")                                     \
+  X(seconds_total, double, , SECONDS, "seconds.total",                         \
+    "wall time of the whole reconstruction, in seconds")                       \
+  X(path, int, , PATH, "path",                                                 \
+    "the path taken: what auto mode chose, and how watertight mode closed "   \
+    "the surface (the SC_PATH_ values)")                                       \
+  X(boundary_samples, uint64_t, , COUNT, "boundary_samples",                   \
+    "samples found not interior (0 in the shortcrust and cocone modes)")       \
+  X(longest_loop, uint64_t, , COUNT, "longest_loop",                           \
+    "edges in the longest boundary loop")                                      \
+  X(loops_by_length, uint64_t, [SC_LOOP_BINS], LOOPS, "loops",                 \
+    "boundary loops by length in edges")                                       \
+  X(cells_relabelled, uint64_t, , COUNT, "cells_relabelled",                   \
+    "watertight: cells moved to the other label to keep a manifold")           \
+  X(bubbles_dropped, uint64_t, , COUNT, "bubbles_dropped",                     \
+    "small closed components removed (boundary, watertight and auto modes)")   \
+  X(samples_attached, uint64_t, , COUNT, "samples_attached",                   \
+    "samples left out by extraction, then inserted into the nearest "         \
+    "triangle")                                                                \
+  X(handles_cut, uint64_t, , COUNT, "handles_cut",                             \
+    "watertight: handles that closed round a hole, cut before closing")
+
 typedef struct sc_diag {
-  uint64_t points_in;          /* points given */
-  uint64_t duplicates_merged;  /* exact duplicates of an earlier point */
-  uint64_t delaunay_vertices;  /* distinct points in the triangulation */
-  uint64_t delaunay_cells;     /* finite tetrahedra */
-  uint64_t delaunay_facets;    /* finite triangles */
-  uint64_t hull_vertices;      /* samples on the convex hull */
-  uint64_t degenerate_cells;   /* flat cells whose circumcentre was guarded */
-  uint64_t candidates;         /* triangles passing the candidate test */
-  uint64_t pruned;             /* candidates removed for a sharp edge */
-  uint64_t triangles;          /* triangles in the output */
-  uint64_t walk_rejected;      /* survivors of pruning left out by the walk */
-  uint64_t holes_filled;       /* small holes closed after the walk */
-  uint64_t hole_triangles;     /* triangles added to close them */
-  uint64_t samples_unused;     /* distinct samples in no output triangle */
-  uint64_t boundary_edges;     /* output edges with a single triangle */
-  uint64_t boundary_loops;     /* closed loops of boundary edges */
-  uint64_t nonmanifold_edges;  /* always 0 on success; kept as a check */
-  uint64_t nonmanifold_vertices; /* always 0 on success; kept as a check */
-  uint64_t components;         /* edge-connected components of the output */
-  uint64_t closed_components;  /* components without boundary */
-  int closed;                  /* 1 when the whole output has no boundary */
-  int64_t euler;               /* V - E + F over the used vertices */
-  int64_t genus;               /* sum of the genera of closed components */
-  double seconds[SC_STAGE_COUNT]; /* wall time per stage */
-  double seconds_total;
-  /* The path taken, one of the SC_PATH_ values below: what auto mode chose,
-   * and whether watertight mode closed the surface with patches or had to
-   * label cells. */
-  int path;
-  uint64_t boundary_samples;  /* samples found not interior (0 in the
-                                 shortcrust and cocone modes) */
-  uint64_t longest_loop;      /* edges in the longest boundary loop */
-  /* Boundary loops by length in edges: 3-10, 11-100, 101-1000, > 1000. */
-  uint64_t loops_by_length[4];
-  uint64_t cells_relabelled;  /* watertight: cells moved to the other label
-                                 to make the surface a manifold */
-  uint64_t bubbles_dropped;   /* small closed components removed (boundary,
-                                 watertight and auto modes) */
-  uint64_t samples_attached;  /* samples left out by extraction and then
-                                 inserted into the nearest triangle */
-  uint64_t handles_cut;       /* watertight: handles that closed round a
-                                 hole, cut before the holes were closed */
+#define SC_DIAG_FIELD_(field, type, dim, kind, wire, help) type field dim;
+  SC_DIAG_MAP(SC_DIAG_FIELD_)
+#undef SC_DIAG_FIELD_
 } sc_diag_t;
 
-/* Values of sc_diag_t.path. */
+/* The diagnostic table as data: sc_diag_table() returns its rows in order
+ * and sets *count. Arrays (STAGE_SECONDS, LOOPS) have count elements, named
+ * on the wire "wire.SUFFIX" with sc_diag_element_name()'s suffix. */
+typedef enum sc_diag_kind {
+  SC_DIAG_COUNT,
+  SC_DIAG_BOOL,
+  SC_DIAG_INT,
+  SC_DIAG_PATH,
+  SC_DIAG_STAGE_SECONDS,
+  SC_DIAG_SECONDS,
+  SC_DIAG_LOOPS
+} sc_diag_kind_t;
+typedef struct sc_diag_info {
+  const char *name; /* the field's name, and the report's */
+  sc_diag_kind_t kind;
+  size_t offset;    /* of the field in sc_diag_t */
+  size_t count;     /* elements: 1, or those of an array */
+  const char *wire; /* the name in JOB_DONE, or the arrays' prefix */
+  const char *help;
+} sc_diag_info_t;
+const sc_diag_info_t *sc_diag_table(size_t *count);
+/* The wire suffix of element i of an array row ("delaunay", "3_10"); NULL
+ * for a scalar row or i out of range. */
+const char *sc_diag_element_name(const sc_diag_info_t *row, size_t i);
+
+/* Values of sc_diag_t.path: X(NAME, value, name).
+ *  - SHORTCRUST: the paper's criteria.
+ *  - COCONE: the cocone test everywhere.
+ *  - BOUNDARY: the cocone test at interior samples only.
+ *  - WATERTIGHT: closed by labelling cells (or nothing was open).
+ *  - WATERTIGHT_FILL: closed by patches over the holes. */
+#define SC_PATH_MAP(X)                                                         \
+  X(SHORTCRUST, 0, "shortcrust")                                               \
+  X(COCONE, 1, "cocone")                                                       \
+  X(BOUNDARY, 2, "boundary")                                                   \
+  X(WATERTIGHT, 3, "watertight")                                               \
+  X(WATERTIGHT_FILL, 4, "watertight-fill")
+
 typedef enum sc_path {
-  SC_PATH_SHORTCRUST = 0,      /* the paper's criteria */
-  SC_PATH_COCONE = 1,          /* the cocone test everywhere */
-  SC_PATH_BOUNDARY = 2,        /* the cocone test at interior samples only */
-  SC_PATH_WATERTIGHT = 3,      /* closed by labelling cells (or nothing
-                                  was open) */
-  SC_PATH_WATERTIGHT_FILL = 4, /* closed by patches over the holes */
+#define SC_PATH_ENUM_(name, value, str) SC_PATH_##name = (value),
+  SC_PATH_MAP(SC_PATH_ENUM_)
+#undef SC_PATH_ENUM_
   SC_PATH_COUNT_
 } sc_path_t;
 
