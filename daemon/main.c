@@ -22,13 +22,7 @@
 static char default_socket[4096];
 
 static const char *socket_default(void) {
-  const char *xdg = getenv("XDG_RUNTIME_DIR");
-  if (xdg && xdg[0] == '/')
-    snprintf(default_socket, sizeof default_socket, "%s/shortcrust.sock", xdg);
-  else
-    snprintf(default_socket, sizeof default_socket,
-             "/run/shortcrust/shortcrust.sock");
-  return default_socket;
+  return scp_default_socket(default_socket, sizeof default_socket);
 }
 
 static void usage(FILE *f, const scd_config_t *d) {

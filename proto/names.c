@@ -5,6 +5,9 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "scproto.h"
+
+#include <stdio.h>
+#include <stdlib.h>
 #include "wire.h"
 
 const char *scp_strerror(int code) {
@@ -208,4 +211,13 @@ int scp__name_ok(const char *name, size_t len) {
 
 int scp__text_ok(const char *text, size_t len) {
   return len <= SCP_MESSAGE_MAX && memchr(text, 0, len) == NULL;
+}
+
+char *scp_default_socket(char *buf, size_t len) {
+  const char *xdg = getenv("XDG_RUNTIME_DIR");
+  if (xdg && xdg[0] == '/')
+    snprintf(buf, len, "%s/shortcrust.sock", xdg);
+  else
+    snprintf(buf, len, "/run/shortcrust/shortcrust.sock");
+  return buf;
 }

@@ -206,6 +206,12 @@ typedef enum scp_stage {
 /* Lower-case name of a stage, local ones included; "?" otherwise. */
 const char *scp_stage_name(uint32_t stage);
 
+/* Where a daemon listens and a client connects when not told otherwise:
+ * $XDG_RUNTIME_DIR/shortcrust.sock when that variable holds an absolute
+ * path, else /run/shortcrust/shortcrust.sock (the system service's). Writes
+ * the path into buf (cut to len - 1 bytes) and returns buf. */
+char *scp_default_socket(char *buf, size_t len);
+
 /* Element formats of chunk frames. */
 typedef enum scp_format {
   SCP_F32_XYZ = 1,
