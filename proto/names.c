@@ -5,10 +5,10 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "scproto.h"
+#include "wire.h"
 
 #include <stdio.h>
 #include <stdlib.h>
-#include "wire.h"
 
 const char *scp_strerror(int code) {
   switch (code) {
