@@ -19,6 +19,20 @@
 #define SC_VERSION "unknown"
 #endif
 
+/* The protocol numbers modes and stages like the core, which the daemon
+ * hands them to unchanged; the two modules know nothing of each other, so
+ * the daemon, which sees both, holds them to it. */
+#define SCD_SAME_MODE_(name, value, str)                                       \
+  _Static_assert((int)SCP_MODE_##name == (int)SC_MODE_##name, "mode " str);
+SC_MODE_MAP(SCD_SAME_MODE_)
+#undef SCD_SAME_MODE_
+_Static_assert((int)SCP_MODE_COUNT == (int)SC_MODE_COUNT_, "the number of modes");
+#define SCD_SAME_STAGE_(name, value, str, what)                                \
+  _Static_assert((int)SCP_STAGE_##name == (int)SC_STAGE_##name, "stage " str);
+SC_STAGE_MAP(SCD_SAME_STAGE_)
+#undef SCD_SAME_STAGE_
+_Static_assert((int)SCP_STAGE_COUNT == (int)SC_STAGE_COUNT, "the number of stages");
+
 static char default_socket[4096];
 
 static const char *socket_default(void) {

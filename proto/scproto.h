@@ -176,8 +176,9 @@ int scp_type_senders(uint16_t type);
 /* Upper-case name of a type ("JOB_BEGIN"); "?" for unknown types. */
 const char *scp_type_name(uint16_t type);
 
-/* Modes, numbered like sc_mode_t in core/shortcrust.h; 2 to 4 are reserved
- * for later and may be refused by a server with UNSUPPORTED. */
+/* Modes, numbered like sc_mode_t in core/shortcrust.h (this module does not
+ * see the core; the daemon, which sees both, checks at compile time that
+ * they agree). A server may refuse a mode it lacks with UNSUPPORTED. */
 typedef enum scp_mode {
   SCP_MODE_SHORTCRUST = 0,
   SCP_MODE_COCONE = 1,
