@@ -1,7 +1,8 @@
 // Handles of an open surface: a region is grown over each component, one
 // triangle at a time, and never takes a triangle that would raise its
 // genus. What stays out is a thin cut across each handle, where the fronts
-// that came round it met.
+// that came round it met. Watertight mode runs it before closing the holes
+// (docs/algorithm.md section 11.2).
 //
 // SPDX-License-Identifier: GPL-3.0-or-later
 

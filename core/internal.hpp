@@ -1,5 +1,5 @@
 // Internals of the core, shared by its translation units. Nothing here is
-// visible outside core/.
+// visible outside core/. Sections cited are those of docs/algorithm.md.
 //
 // SPDX-License-Identifier: GPL-3.0-or-later
 #ifndef SC_CORE_INTERNAL_HPP
@@ -83,7 +83,7 @@ struct Filtered {
   std::vector<std::pair<uint32_t, uint32_t>> dups; // (duplicate, first), input
   // Per vertex: 0 for an interior sample, kBoundarySample or kOpenSample
   // for the others; empty when boundary detection did not run, or found
-  // too few interior samples to tell (the sample is then taken as closed).
+  // too few interior samples to tell (then taken as closed: section 5.5).
   std::vector<uint8_t> boundary;
 };
 
@@ -112,10 +112,10 @@ public:
   virtual void filter(const double *xyz, size_t n, const sc_params_t &params,
                       Progress &progress, Filtered &out, sc_diag_t &diag,
                       double seconds[SC_STAGE_COUNT]) = 0;
-  // Watertight mode, on a triangulation of the surface's (distinct) points
-  // inserted in the order of its vertex numbers, without filter(): labels
-  // the cells inside or outside across the oriented surface tris (vertex
-  // numbers) and
+  // Watertight mode (section 11.4), on a triangulation of the surface's
+  // (distinct) points inserted in the order of its vertex numbers, without
+  // filter(): labels the cells inside or outside across the oriented
+  // surface tris (vertex numbers) and
   // replaces tris by the boundary of the inside cells, repaired into a
   // 2-manifold as far as relabelling goes (a few pinched vertices may be
   // left). Returns false, leaving tris as it was, when no cell is inside.
@@ -169,14 +169,16 @@ EdgeTablePtr new_edge_table();
 // Frees the arrays that this thread's edge tables and vertex stars keep
 // for reuse (surface.cpp); called at the end of each reconstruction.
 void release_scratch();
-// keep_vertex, when not empty, marks the vertices at which no edge is ever
-// sharp (boundary samples). Leaves the candidates' edge table in `table`.
+// Sharp-edge pruning (section 7). keep_vertex, when not empty, marks the
+// vertices at which no edge is ever sharp (boundary samples). Leaves the
+// candidates' edge table in `table`.
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
            bool erode_single, const std::vector<uint8_t> &keep_vertex,
            std::vector<uint8_t> &alive, EdgeTablePtr &table,
            Progress &progress, sc_diag_t &diag);
-// Takes the table prune() left for the same candidates and alive flags.
-// Holes mostly rimmed by samples marked in boundary are left open.
+// The walk and small holes (sections 8 and 9). Takes the table prune()
+// left for the same candidates and alive flags. Holes mostly rimmed by
+// samples marked in boundary are left open.
 // `check_vertices` as in describe(): pass false only when an open surface
 // will be described again before it is output.
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
@@ -184,13 +186,13 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              size_t max_hole, const std::vector<uint8_t> &boundary,
              Progress &progress, Surface &out, sc_diag_t &diag,
              bool check_vertices = true);
-// The topology of a finished surface: components, boundary loops, genus,
-// manifold checks; closed components facing inward are flipped. Resets and
-// fills the output fields of diag (triangles, boundary, components ...).
+// The topology of a finished surface (section 10): components, boundary loops,
+// genus, manifold checks; closed components facing inward are flipped. Resets
+// and fills the output fields of diag (triangles, boundary, components ...).
 // `table`, when given, is the edge table of tris (it saves building one).
-// Without check_vertices, the vertices of a surface with an open component
-// are taken to be manifold, as extraction leaves them, instead of checked
-// (a third of the time here); a closed surface is checked either way.
+// Without check_vertices, the vertices of a surface with an open component are
+// taken to be manifold, as extraction leaves them, instead of checked (a third
+// of the time here); a closed surface is checked either way.
 void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
               Progress &progress, Surface &out, sc_diag_t &diag,
               const EdgeTable *table = nullptr, bool check_vertices = true);
@@ -198,25 +200,25 @@ void describe(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 void summarise(Surface &s, sc_diag_t &diag);
 // Counts s.loops into s.parts (loops, the longest, loops by length).
 void tally_loops(Surface &s);
-// Puts the triangles in one order that depends only on the set: each
-// rotated to start at its smallest vertex number (keep_orientation) or with
-// its numbers ascending, then all sorted. Which Delaunay cell reports a
-// facet depends on heap addresses; with this, two runs on the same points
-// (a daemon job and a local run) list the same triangles in the same order.
+// Puts the triangles in one order that depends only on the set (section 13):
+// each rotated to start at its smallest vertex number (keep_orientation) or
+// with its numbers ascending, then all sorted. Which Delaunay cell reports a
+// facet depends on heap addresses; with this, two runs on the same points (a
+// daemon job and a local run) list the same triangles in the same order.
 void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation);
-// Removes the closed components of fewer than min_triangles triangles
-// (bubbles between the layers of overlapping scans), and the open ones too
+// Removes the closed components of fewer than min_triangles triangles (bubbles
+// between the layers of overlapping scans, section 11.1), and the open ones too
 // when open_too, from a surface that describe() filled; s and diag then
 // describe what is left. Returns the triangles removed.
 size_t drop_small_closed(const double *xyz, size_t n, Surface &s,
                          size_t min_triangles, bool open_too,
                          Progress &progress, sc_diag_t &diag);
 // Inserts every sample that is in no triangle into the nearest triangle
-// (splitting it in three, or the two triangles of the nearest edge in
-// two each) when it is closer to it than the triangle's longest edge.
-// Keeps the surface a consistently oriented manifold, with its components,
-// genus and loops; s and diag, which describe() filled, describe the
-// result. Returns the count.
+// (section 12: splitting it in three, or the two triangles of the nearest edge
+// in two each) when it is closer to it than the triangle's longest edge. Keeps
+// the surface a consistently oriented manifold, with its components, genus and
+// loops; s and diag, which describe() filled, describe the result. Returns the
+// count.
 size_t attach_samples(const double *xyz, size_t n, Surface &s,
                       Progress &progress, sc_diag_t &diag);
 // Removes every triangle on an edge with more than two, then keeps the
@@ -244,23 +246,23 @@ void append_edges_of(EdgeTable &et, size_t n,
                      const std::vector<uint32_t> &tris, size_t first_new,
                      Progress &progress);
 // Cuts the handles of an oriented, edge- and vertex-manifold surface that
-// closed round a hole: grows a region over each component, nearest triangle
-// first, refusing every triangle that would join two of its boundary loops
-// (raise its genus), then takes out the refused triangles of each cut that
-// runs mostly along holes and keeps the others. The result is a manifold
-// again; returns the number of cuts. Leaves the edge table of the result
-// (as fill_holes() builds it) in `table`.
+// closed round a hole (section 11.2): grows a region over each component,
+// nearest triangle first, refusing every triangle that would join two of its
+// boundary loops (raise its genus), then takes out the refused triangles of
+// each cut that runs mostly along holes and keeps the others. The result is a
+// manifold again; returns the number of cuts. Leaves the edge table of the
+// result (as fill_holes() builds it) in `table`.
 size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                    Progress &progress, EdgeTable &table);
-// Closes every hole of at most max_loop edges by a least-area patch (a loop
-// of more than 16 edges is first cut by short chords into
-// pieces), except the loops that boundary (which may be empty) marks as
-// where the surface ends. The patches together take at most max_work steps
-// of the dynamic programme (about L^3 / 6 for a loop of L edges); loops
-// beyond it stay. `table`, when given, is the edge table of tris, or an
-// empty table (new_edge_table()) to build it in; either way it is the table
-// of the filled tris on return, for describe(), though no longer in
-// angular order about each edge.
+// Closes every hole of at most max_loop edges by a least-area patch (sections 9
+// and 11.3; a loop of more than 16 edges is first cut by short chords into
+// pieces), except the loops that boundary (which may be empty) marks as where
+// the surface ends. The patches together take at most max_work steps of the
+// dynamic programme (about L^3 / 6 for a loop of L edges); loops beyond it
+// stay. `table`, when given, is the edge table of tris, or an empty table
+// (new_edge_table()) to build it in; either way it is the table of the filled
+// tris on return, for describe(), though no longer in angular order about each
+// edge.
 void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                 size_t max_loop, const std::vector<uint8_t> &boundary,
                 Progress &progress, sc_diag_t &diag,

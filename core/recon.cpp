@@ -1,5 +1,6 @@
 // One reconstruction from input to mesh: validation, the triangulation
-// stages, pruning, extraction, and the result handed back to C.
+// stages, pruning, extraction, and the result handed back to C. The steps
+// and their order: docs/algorithm.md, section 1.2.
 //
 // SPDX-License-Identifier: GPL-3.0-or-later
 
@@ -89,7 +90,8 @@ struct Closure {
 
 } // namespace
 
-// Watertight mode, after extraction: closes the open components of surf.
+// Watertight mode, after extraction (docs/algorithm.md sections 11.2 to
+// 11.5): closes the open components of surf.
 // First the least-area patches over each loop, which keep the surface as
 // it is; if they leave a closed manifold, that is the result. Otherwise the
 // Delaunay cells are labelled across the surface, which closes holes of any
@@ -346,8 +348,9 @@ sc_mesh_t *Recon::finish() {
         attach_samples(lxyz.data(), m, surf, progress, diag);
   }
 
-  // Per-vertex normals: the pole direction, signed to agree with the
-  // area-weighted normal of the output triangles around the vertex.
+  // Per-vertex normals (docs/algorithm.md section 13): the pole direction,
+  // signed to agree with the area-weighted normal of the output triangles
+  // around the vertex.
   std::vector<double> acc(3 * m, 0.0);
   const size_t nt = surf.tris.size() / 3;
   for (size_t t = 0; t < nt; ++t) {
