@@ -48,7 +48,8 @@ const char *sc_strerror(int code);
 /* The code's name without the prefix, e.g. "NONFINITE"; "UNKNOWN" otherwise. */
 const char *sc_err_name(int code);
 
-/* Candidate selection (ALGORITHM.md section 3, and section 6 for the rest).
+/* Candidate selection (docs/algorithm.md section 6; sections 5 and 11 for
+ * the modes for scans).
  * One row per mode: X(NAME, value, name): the numbering is the wire
  * protocol's too (proto/PROTOCOL.md section 4), and the name is how the
  * command line, reports and logs spell the mode.
@@ -56,11 +57,12 @@ const char *sc_err_name(int code);
  *    parameter r.
  *  - COCONE: the cocone test: the dual Voronoi edge meets the cocone of all
  *    three vertices.
- *  - BOUNDARY: for scans with a boundary (ALGORITHM.md section 6): samples
- *    are sorted into interior and boundary ones (Dey and Giesen's ratio and
- *    normal tests, parameters boundary_rho and boundary_alpha); the cocone
- *    test is made only at interior vertices, and no edge at a boundary
- *    sample is pruned, so the output is a 2-manifold with boundary.
+ *  - BOUNDARY: for scans with a boundary (docs/algorithm.md sections 5 and
+ *    11): samples are sorted into interior and boundary ones (Dey and
+ *    Giesen's ratio and normal tests, parameters boundary_rho and
+ *    boundary_alpha); the cocone test is made only at interior vertices,
+ *    and no edge at a boundary sample is pruned, so the output is a
+ *    2-manifold with boundary.
  *  - WATERTIGHT: boundary mode, then every hole is closed: handles that
  *    closed round a hole are cut, each boundary loop gets a least-area
  *    patch, and where the patches cannot close the surface the Delaunay
@@ -270,8 +272,8 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
 #define SC_LOOP_BINS 4
 
 /*
- * Diagnostics of one reconstruction (ALGORITHM.md section 7), one row each:
- * sc_diag_t, the report (`--report`), the daemon's JOB_DONE values
+ * Diagnostics of one reconstruction (docs/algorithm.md section 15), one row
+ * each: sc_diag_t, the report (`--report`), the daemon's JOB_DONE values
  * (proto/PROTOCOL.md section 6.12) and the command's reading of them are
  * made from this table.
  *
