@@ -826,12 +826,9 @@ static void on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
   scd_server_t *srv = c->srv;
   scp_job_begin_t m;
   memset(&m, 0, sizeof m);
-  int rc = scp_parse_job_begin(f, &m);
+  /* Options are only for connections that agreed on them. */
+  int rc = scp_parse_job_begin_features(f, c->features, &m);
   uint32_t id = m.job_id;
-  /* Options are only for connections that agreed on them: without the
-   * feature, a JOB_BEGIN longer than 40 bytes is malformed. */
-  if (f->length > 40 && !(c->features & SCP_FEATURE_JOB_OPTIONS))
-    rc = SCP_ELENGTH;
   if (rc != 0) {
     if (scp_err_is_fatal(rc)) {
       protocol_fatal(c, rc, 0, f->type);
