@@ -101,82 +101,52 @@ static uint32_t apply_options(const scp_values_t *options, sc_params_t *p,
   return 0;
 }
 
-void scd_on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
-  scd_server_t *srv = c->srv;
-  scp_job_begin_t m;
-  memset(&m, 0, sizeof m);
-  /* Options are only for connections that agreed on them. */
-  int rc = scp_parse_job_begin_features(f, c->features, &m);
-  uint32_t id = m.job_id;
-  if (rc != 0) {
-    if (scp_err_is_fatal(rc)) {
-      scd_conn_protocol_fatal(c, rc, 0, f->type);
-      return;
-    }
-    if (!scp_frame_job_id(f, &id) || id == 0)
-      scd_conn_reply_error(c, SCP_WIRE_INVALID, 0, f->type, "JOB_BEGIN: %s",
-                           scp_strerror(rc));
-    else if (scd_job_find(c, id))
-      scd_conn_reply_error(c, SCP_WIRE_DUPLICATE_JOB, id, f->type,
-                           "job %u is in use", id);
-    else if (c->njobs >= srv->cfg.max_jobs)
-      scd_conn_fatal(c, SCP_WIRE_LIMIT, id, f->type,
-                     "more than %u jobs in use on one connection",
-                     srv->cfg.max_jobs);
-    else
-      scd_job_refuse(c, id, scp_err_to_wire(rc), "JOB_BEGIN: %s",
-                     scp_strerror(rc));
-    return;
-  }
-  if (scd_job_find(c, id)) {
-    scd_conn_reply_error(c, SCP_WIRE_DUPLICATE_JOB, id, f->type,
-                         "job %u is in use", id);
-    return;
-  }
-  if (c->njobs >= srv->cfg.max_jobs) {
-    scd_conn_fatal(c, SCP_WIRE_LIMIT, id, f->type,
-                   "more than %u jobs in use on one connection",
-                   srv->cfg.max_jobs);
-    return;
-  }
+/* Whether this server takes the job that JOB_BEGIN m describes, and the
+ * job's parameters in *params: 0, or the wire code to refuse it with and
+ * the reason in why. */
+static uint32_t check_job(const scd_server_t *srv, const scp_job_begin_t *m,
+                          sc_params_t *params, char *why, size_t len) {
   if (srv->shutting_down) {
-    scd_job_refuse(c, id, SCP_WIRE_SHUTDOWN, "server shutting down");
-    return;
+    snprintf(why, len, "server shutting down");
+    return SCP_WIRE_SHUTDOWN;
   }
   /* The protocol numbers modes like the core; a mode the core was built
    * without is refused. */
-  if (m.mode >= (uint32_t)SC_MODE_COUNT_) {
-    scd_job_refuse(c, id, SCP_WIRE_UNSUPPORTED,
-                   "mode %s is not supported by this server",
-                   scp_mode_name(m.mode));
-    return;
+  if (m->mode >= (uint32_t)SC_MODE_COUNT_) {
+    snprintf(why, len, "mode %s is not supported by this server",
+             scp_mode_name(m->mode));
+    return SCP_WIRE_UNSUPPORTED;
   }
-  sc_params_t params;
-  sc_params_init(&params);
-  params.mode = (sc_mode_t)m.mode;
-  params.r = m.r;
-  if (m.theta != 0)
-    params.cocone_theta = m.theta;
-  params.threads = 1;
-  char why[SCP_MESSAGE_MAX + 1];
-  uint32_t refused = apply_options(&m.options, &params, why, sizeof why);
-  if (refused) {
-    scd_job_refuse(c, id, refused, "%s", why);
-    return;
+  sc_params_init(params);
+  params->mode = (sc_mode_t)m->mode;
+  params->r = m->r;
+  if (m->theta != 0)
+    params->cocone_theta = m->theta;
+  params->threads = 1;
+  uint32_t refused = apply_options(&m->options, params, why, len);
+  if (refused)
+    return refused;
+  if (m->point_count > srv->max_points) {
+    snprintf(why, len,
+             "job of %llu points; this server takes at most %llu per job",
+             (ull)m->point_count, (ull)srv->max_points);
+    return SCP_WIRE_LIMIT;
   }
-  if (m.point_count > srv->max_points) {
-    scd_job_refuse(c, id, SCP_WIRE_LIMIT,
-                   "job of %llu points; this server takes at most %llu per job",
-                   (ull)m.point_count, (ull)srv->max_points);
-    return;
-  }
+  return 0;
+}
+
+/* Makes the task of a job the server takes, reserves its memory and hands
+ * it to the pool: ACCEPTED, or JOB_ERROR when the memory is not there. */
+static void start_job(scd_conn_t *c, uint32_t id, const scp_job_begin_t *m,
+                      const sc_params_t *params) {
+  scd_server_t *srv = c->srv;
   scd_task_t *t = scd_task_new();
   if (!t) {
     scd_job_refuse(c, id, SCP_WIRE_NO_MEMORY, "out of memory");
     return;
   }
   srv->tasks_live++;
-  uint64_t need = sc_estimate_bytes(m.point_count);
+  uint64_t need = sc_estimate_bytes(m->point_count);
   if (scd_budget_reserve(srv, t, need) != 0) {
     char a[32], b[32], d[32];
     fmt_bytes(a, sizeof a, need);
@@ -195,12 +165,12 @@ void scd_on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
     scd_conn_close_now(c, "out of memory");
     return;
   }
-  t->params = params;
+  t->params = *params;
   t->owner = j;
   j->task = t;
   j->phase = SCD_JOB_UPLOADING;
-  j->declared = m.point_count;
-  j->flags = m.flags;
+  j->declared = m->point_count;
+  j->flags = m->flags;
   scd_pool_stats_t ps;
   scd_pool_get_stats(srv->pool, &ps);
   scd_pool_submit(srv->pool, t);
@@ -212,8 +182,56 @@ void scd_on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
   scd_conn_sent(c, scp_enc_accepted(&c->out, &a));
   scd_debug("job %llu:%u accepted: mode %s, %llu points announced, %u job "
             "options",
-            (ull)c->id, id, scp_mode_name(m.mode), (ull)m.point_count,
-            m.options.count);
+            (ull)c->id, id, scp_mode_name(m->mode), (ull)m->point_count,
+            m->options.count);
+}
+
+/* JOB_BEGIN, PROTOCOL.md 7.3; each check is made once, and their order
+ * decides the reply. A frame that cannot be trusted costs the connection,
+ * one that names no id is answered with ERROR INVALID, an id in use with
+ * ERROR DUPLICATE_JOB, and an id beyond max_jobs with a fatal LIMIT. From
+ * then on the id is claimed: a refusal, of an invalid frame or of a job
+ * this server does not take, is a JOB_ERROR after which the id drains. */
+void scd_on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
+  scd_server_t *srv = c->srv;
+  scp_job_begin_t m;
+  memset(&m, 0, sizeof m);
+  /* Options are only for connections that agreed on them. */
+  int rc = scp_parse_job_begin_features(f, c->features, &m);
+  if (rc != 0 && scp_err_is_fatal(rc)) {
+    scd_conn_protocol_fatal(c, rc, 0, f->type);
+    return;
+  }
+  uint32_t id = m.job_id;
+  if (rc != 0 && (!scp_frame_job_id(f, &id) || id == 0)) {
+    scd_conn_reply_error(c, SCP_WIRE_INVALID, 0, f->type, "JOB_BEGIN: %s",
+                         scp_strerror(rc));
+    return;
+  }
+  if (scd_job_find(c, id)) {
+    scd_conn_reply_error(c, SCP_WIRE_DUPLICATE_JOB, id, f->type,
+                         "job %u is in use", id);
+    return;
+  }
+  if (c->njobs >= srv->cfg.max_jobs) {
+    scd_conn_fatal(c, SCP_WIRE_LIMIT, id, f->type,
+                   "more than %u jobs in use on one connection",
+                   srv->cfg.max_jobs);
+    return;
+  }
+  if (rc != 0) {
+    scd_job_refuse(c, id, scp_err_to_wire(rc), "JOB_BEGIN: %s",
+                   scp_strerror(rc));
+    return;
+  }
+  sc_params_t params;
+  char why[SCP_MESSAGE_MAX + 1];
+  uint32_t refused = check_job(srv, &m, &params, why, sizeof why);
+  if (refused) {
+    scd_job_refuse(c, id, refused, "%s", why);
+    return;
+  }
+  start_job(c, id, &m, &params);
 }
 
 /* Hands the points gathered so far to the pool. */
