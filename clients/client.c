@@ -367,6 +367,50 @@ int scc_flush_out(sc_client_t *c) {
 
 static int cond_ready(sc_client_t *c, void *arg) { return c->ready != 0; }
 
+/* Connects c->fd to the daemon's socket at path and makes it
+ * non-blocking: 0, or the error code with its message in msg. */
+static int connect_socket(sc_client_t *c, const char *path, char *msg,
+                          size_t msg_len) {
+  struct sockaddr_un sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sun_family = AF_UNIX;
+  if (strlen(path) >= sizeof sa.sun_path) {
+    set_msg(msg, msg_len, "socket path too long (at most %zu bytes): %s",
+            sizeof sa.sun_path - 1, path);
+    return SC_CLIENT_ECONNECT;
+  }
+  memcpy(sa.sun_path, path, strlen(path) + 1);
+  c->fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (c->fd < 0) {
+    set_msg(msg, msg_len, "socket: %s", strerror(errno));
+    return SC_CLIENT_ECONNECT;
+  }
+  int rc;
+  do
+    rc = connect(c->fd, (struct sockaddr *)&sa, sizeof sa);
+  while (rc != 0 && errno == EINTR);
+  if (rc != 0) {
+    int e = errno;
+    int code = (e == ENOENT || e == ECONNREFUSED) ? SC_CLIENT_ENODAEMON
+                                                  : SC_CLIENT_ECONNECT;
+    if (code == SC_CLIENT_ENODAEMON)
+      set_msg(msg, msg_len,
+              "the daemon is not running: nothing listens on %s (%s); start "
+              "shortcrustd or give its socket",
+              path, strerror(e));
+    else
+      set_msg(msg, msg_len, "cannot connect to the daemon on %s: %s", path,
+              strerror(e));
+    return code;
+  }
+  int fl = fcntl(c->fd, F_GETFL);
+  if (fl < 0 || fcntl(c->fd, F_SETFL, fl | O_NONBLOCK) < 0) {
+    set_msg(msg, msg_len, "fcntl: %s", strerror(errno));
+    return SC_CLIENT_ECONNECT;
+  }
+  return 0;
+}
+
 int sc_client_connect(const sc_client_options_t *opts, sc_client_t **out,
                       char *msg, size_t msg_len) {
   if (out)
@@ -406,46 +450,10 @@ int sc_client_connect(const sc_client_options_t *opts, sc_client_t **out,
   }
 
   const char *path = o.socket_path ? o.socket_path : c->path;
-  struct sockaddr_un sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sun_family = AF_UNIX;
-  if (strlen(path) >= sizeof sa.sun_path) {
-    set_msg(msg, msg_len, "socket path too long (at most %zu bytes): %s",
-            sizeof sa.sun_path - 1, path);
-    sc_client_free(c);
-    return SC_CLIENT_ECONNECT;
-  }
-  memcpy(sa.sun_path, path, strlen(path) + 1);
-  c->fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (c->fd < 0) {
-    set_msg(msg, msg_len, "socket: %s", strerror(errno));
-    sc_client_free(c);
-    return SC_CLIENT_ECONNECT;
-  }
-  int rc;
-  do
-    rc = connect(c->fd, (struct sockaddr *)&sa, sizeof sa);
-  while (rc != 0 && errno == EINTR);
+  int rc = connect_socket(c, path, msg, msg_len);
   if (rc != 0) {
-    int e = errno;
-    int code = (e == ENOENT || e == ECONNREFUSED) ? SC_CLIENT_ENODAEMON
-                                                  : SC_CLIENT_ECONNECT;
-    if (code == SC_CLIENT_ENODAEMON)
-      set_msg(msg, msg_len,
-              "the daemon is not running: nothing listens on %s (%s); start "
-              "shortcrustd or give its socket",
-              path, strerror(e));
-    else
-      set_msg(msg, msg_len, "cannot connect to the daemon on %s: %s", path,
-              strerror(e));
     sc_client_free(c);
-    return code;
-  }
-  int fl = fcntl(c->fd, F_GETFL);
-  if (fl < 0 || fcntl(c->fd, F_SETFL, fl | O_NONBLOCK) < 0) {
-    set_msg(msg, msg_len, "fcntl: %s", strerror(errno));
-    sc_client_free(c);
-    return SC_CLIENT_ECONNECT;
+    return rc;
   }
 
   c->hello = (scp_hello_t){.version_min = SCP_VERSION,

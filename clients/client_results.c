@@ -42,6 +42,100 @@ static void *grow(void *p, uint64_t *cap, uint64_t need, size_t size) {
   return q;
 }
 
+/* Which of the job's arrays a chunk frame fills (SC_CLIENT_TRIANGLES,
+ * SC_CLIENT_NORMALS or SC_CLIENT_COMPONENTS), with the elements of it that
+ * came before in *have; -1 after a protocol error. */
+static int chunk_array(sc_client_t *c, sc_client_job_t *j, uint16_t type,
+                       const scp_chunk_t *ch, uint64_t *have) {
+  switch (type) {
+  case SCP_TRIANGLES:
+    *have = j->ntri;
+    return SC_CLIENT_TRIANGLES;
+  case SCP_NORMALS:
+    *have = j->nnormals;
+    if (!j->params.normals || ch->format != SCP_F64_XYZ) {
+      scc_protocol_error(c, "NORMALS for job %u, which asked for %s", j->id,
+                         j->params.normals ? "F64_XYZ normals" : "none");
+      return -1;
+    }
+    if (ch->first + ch->count > j->n) {
+      scc_protocol_error(c, "job %u: more normals than its %llu points", j->id,
+                         (unsigned long long)j->n);
+      return -1;
+    }
+    return SC_CLIENT_NORMALS;
+  default:
+    *have = j->ncomp;
+    return SC_CLIENT_COMPONENTS;
+  }
+}
+
+/* Where a chunk of count elements of the array decodes to: the job's
+ * buffer, grown as needed, or scratch space (also in *scratch, for the
+ * caller to free) when a chunk callback takes the mesh. NULL when out of
+ * memory. */
+static void *chunk_dest(sc_client_job_t *j, int array, uint64_t have,
+                        uint32_t count, void **scratch) {
+  size_t esize = array == SC_CLIENT_TRIANGLES ? 3 * sizeof(uint32_t)
+                 : array == SC_CLIENT_NORMALS ? 3 * sizeof(double)
+                                              : sizeof(int32_t);
+  *scratch = NULL;
+  if (j->params.chunk)
+    return *scratch = malloc((size_t)count * esize);
+  if (array == SC_CLIENT_TRIANGLES) {
+    uint32_t *t = grow(j->tri, &j->tri_cap, have + count, esize);
+    if (t)
+      j->tri = t;
+    return t ? t + 3 * have : NULL;
+  }
+  if (array == SC_CLIENT_NORMALS) {
+    if (!j->normals)
+      j->normals = malloc((size_t)j->n * esize);
+    return j->normals ? j->normals + 3 * have : NULL;
+  }
+  int32_t *g = grow(j->genus, &j->comp_cap, have + count, esize);
+  if (g)
+    j->genus = g;
+  return g ? g + have : NULL;
+}
+
+/* Decodes the chunk into dst and checks its elements against the job;
+ * the job's count of the array grows. -1 after a protocol error. */
+static int store_chunk(sc_client_t *c, sc_client_job_t *j, int array,
+                       const scp_chunk_t *ch, uint64_t have, void *dst) {
+  if (array == SC_CLIENT_TRIANGLES) {
+    uint32_t *t = dst;
+    scp_chunk_copy_triangles(ch, t);
+    for (uint64_t i = 0; i < 3 * (uint64_t)ch->count; i++) {
+      if (t[i] >= j->n) {
+        scc_protocol_error(c,
+                           "job %u: triangle %llu has index %u, but the job "
+                           "has %llu points",
+                           j->id, (unsigned long long)(have + i / 3), t[i],
+                           (unsigned long long)j->n);
+        return -1;
+      }
+    }
+    j->ntri += ch->count;
+  } else if (array == SC_CLIENT_NORMALS) {
+    scp_chunk_copy_xyz(ch, dst);
+    j->nnormals += ch->count;
+  } else {
+    int32_t *g = dst;
+    scp_chunk_copy_i32(ch, g);
+    for (uint32_t i = 0; i < ch->count; i++) {
+      if (g[i] < -1) {
+        scc_protocol_error(c, "job %u: component genus %d", j->id, g[i]);
+        return -1;
+      }
+    }
+    j->ncomp += ch->count;
+  }
+  return 0;
+}
+
+/* TRIANGLES, NORMALS and COMPONENTS: kept in the job, or handed to its
+ * chunk callback. */
 static void on_chunk(sc_client_t *c, const scp_frame_t *f) {
   scp_chunk_t ch;
   int rc = scp_parse_chunk(f, &ch);
@@ -60,61 +154,18 @@ static void on_chunk(sc_client_t *c, const scp_frame_t *f) {
     return;
   if (!j->t_first_chunk)
     j->t_first_chunk = scc_now_s();
-  int array;
   uint64_t have;
-  switch (f->type) {
-  case SCP_TRIANGLES:
-    array = SC_CLIENT_TRIANGLES;
-    have = j->ntri;
-    break;
-  case SCP_NORMALS:
-    array = SC_CLIENT_NORMALS;
-    have = j->nnormals;
-    if (!j->params.normals || ch.format != SCP_F64_XYZ) {
-      scc_protocol_error(c, "NORMALS for job %u, which asked for %s", j->id,
-                         j->params.normals ? "F64_XYZ normals" : "none");
-      return;
-    }
-    if (ch.first + ch.count > j->n) {
-      scc_protocol_error(c, "job %u: more normals than its %llu points", j->id,
-                         (unsigned long long)j->n);
-      return;
-    }
-    break;
-  default:
-    array = SC_CLIENT_COMPONENTS;
-    have = j->ncomp;
-    break;
-  }
+  int array = chunk_array(c, j, f->type, &ch, &have);
+  if (array < 0)
+    return;
   if (ch.first != have) {
     scc_protocol_error(c, "job %u: %s chunk starts at %llu, expected %llu",
                        j->id, scp_type_name(f->type),
                        (unsigned long long)ch.first, (unsigned long long)have);
     return;
   }
-  /* Decoded into the job's buffer, or into scratch space for a callback. */
-  void *dst;
-  void *scratch = NULL;
-  size_t esize = array == SC_CLIENT_TRIANGLES ? 3 * sizeof(uint32_t)
-                 : array == SC_CLIENT_NORMALS ? 3 * sizeof(double)
-                                              : sizeof(int32_t);
-  if (j->params.chunk) {
-    dst = scratch = malloc((size_t)ch.count * esize);
-  } else if (array == SC_CLIENT_TRIANGLES) {
-    uint32_t *t = grow(j->tri, &j->tri_cap, have + ch.count, esize);
-    if (t)
-      j->tri = t;
-    dst = t ? t + 3 * have : NULL;
-  } else if (array == SC_CLIENT_NORMALS) {
-    if (!j->normals)
-      j->normals = malloc((size_t)j->n * esize);
-    dst = j->normals ? j->normals + 3 * have : NULL;
-  } else {
-    int32_t *g = grow(j->genus, &j->comp_cap, have + ch.count, esize);
-    if (g)
-      j->genus = g;
-    dst = g ? g + have : NULL;
-  }
+  void *scratch;
+  void *dst = chunk_dest(j, array, have, ch.count, &scratch);
   if (!dst) {
     /* The stream is fine, but we cannot hold this job's mesh. */
     snprintf(j->message, sizeof j->message,
@@ -125,35 +176,9 @@ static void on_chunk(sc_client_t *c, const scp_frame_t *f) {
     free(scratch);
     return;
   }
-  if (array == SC_CLIENT_TRIANGLES) {
-    uint32_t *t = dst;
-    scp_chunk_copy_triangles(&ch, t);
-    for (uint64_t i = 0; i < 3 * (uint64_t)ch.count; i++) {
-      if (t[i] >= j->n) {
-        free(scratch);
-        scc_protocol_error(c,
-                           "job %u: triangle %llu has index %u, but the job "
-                           "has %llu points",
-                           j->id, (unsigned long long)(have + i / 3), t[i],
-                           (unsigned long long)j->n);
-        return;
-      }
-    }
-    j->ntri += ch.count;
-  } else if (array == SC_CLIENT_NORMALS) {
-    scp_chunk_copy_xyz(&ch, dst);
-    j->nnormals += ch.count;
-  } else {
-    int32_t *g = dst;
-    scp_chunk_copy_i32(&ch, g);
-    for (uint32_t i = 0; i < ch.count; i++) {
-      if (g[i] < -1) {
-        free(scratch);
-        scc_protocol_error(c, "job %u: component genus %d", j->id, g[i]);
-        return;
-      }
-    }
-    j->ncomp += ch.count;
+  if (store_chunk(c, j, array, &ch, have, dst) != 0) {
+    free(scratch);
+    return;
   }
   if (j->params.chunk) {
     c->in_callback++;
