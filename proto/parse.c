@@ -131,9 +131,12 @@ int scp_parse_pong(const scp_frame_t *f, uint64_t *token) {
 
 int scp_parse_job_begin(const scp_frame_t *f, scp_job_begin_t *out) {
   const uint8_t *p = f->payload;
-  /* 40 bytes, or 48 and a list of job options (PROTOCOL.md 6.3). */
-  int rc = f->length > 40 && f->length < 48 ? exact(f, SCP_JOB_BEGIN, 40)
-                                            : at_least(f, SCP_JOB_BEGIN, 40);
+  /* The fixed part, or that, 8 bytes of count and reserved, and a list of
+   * job options (PROTOCOL.md 6.3). */
+  const uint32_t fixed = SCP_JOB_BEGIN_FIXED, list = SCP_JOB_BEGIN_FIXED + 8;
+  int rc = f->length > fixed && f->length < list
+               ? exact(f, SCP_JOB_BEGIN, fixed)
+               : at_least(f, SCP_JOB_BEGIN, fixed);
   if (rc || (rc = zero32(p + 36)))
     return rc;
   out->job_id = scp__ld32(p);
@@ -143,15 +146,23 @@ int scp_parse_job_begin(const scp_frame_t *f, scp_job_begin_t *out) {
   out->point_count = scp__ld64(p + 24);
   out->flags = scp__ld32(p + 32);
   out->options = (scp_values_t){0, NULL, 0};
-  if (f->length > 40) {
-    if ((rc = zero32(p + 44)) ||
-        (rc = parse_values(p + 48, f->length - 48, scp__ld32(p + 40),
+  if (f->length > fixed) {
+    if ((rc = zero32(p + fixed + 4)) ||
+        (rc = parse_values(p + list, f->length - list, scp__ld32(p + fixed),
                            &out->options)))
       return rc;
     if (out->options.count == 0)
       return SCP_ERANGE;
   }
   return scp__check_job_begin(out);
+}
+
+int scp_parse_job_begin_features(const scp_frame_t *f, uint64_t features,
+                                 scp_job_begin_t *out) {
+  if (f->type == SCP_JOB_BEGIN && f->length > SCP_JOB_BEGIN_FIXED &&
+      !(features & SCP_FEATURE_JOB_OPTIONS))
+    return SCP_ELENGTH;
+  return scp_parse_job_begin(f, out);
 }
 
 int scp_parse_job_end(const scp_frame_t *f, scp_job_end_t *out) {

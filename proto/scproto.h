@@ -66,6 +66,9 @@ extern "C" {
 #define SCP_NAME_MAX 63
 /* Fixed part of every chunk frame (POINTS, TRIANGLES, NORMALS, COMPONENTS). */
 #define SCP_CHUNK_HEADER 24
+/* Fixed part of JOB_BEGIN; job options follow it, where the JOB_OPTIONS
+ * feature is in force, from byte SCP_JOB_BEGIN_FIXED + 8 on. */
+#define SCP_JOB_BEGIN_FIXED 40
 
 /*
  * Error codes of this library. Each row gives the name, the value, the wire
@@ -612,6 +615,12 @@ int scp_parse_error(const scp_frame_t *f, scp_error_t *out);
 int scp_parse_ping(const scp_frame_t *f, uint64_t *token);
 int scp_parse_pong(const scp_frame_t *f, uint64_t *token);
 int scp_parse_job_begin(const scp_frame_t *f, scp_job_begin_t *out);
+/* JOB_BEGIN on a connection whose handshake agreed on features (WELCOME's):
+ * without SCP_FEATURE_JOB_OPTIONS a payload longer than the fixed part is
+ * malformed (SCP_ELENGTH, PROTOCOL.md 6.3), whatever else is wrong with it;
+ * otherwise the same as scp_parse_job_begin(). */
+int scp_parse_job_begin_features(const scp_frame_t *f, uint64_t features,
+                                 scp_job_begin_t *out);
 int scp_parse_job_end(const scp_frame_t *f, scp_job_end_t *out);
 int scp_parse_cancel(const scp_frame_t *f, uint32_t *job_id);
 int scp_parse_stats_request(const scp_frame_t *f, uint32_t *tag);

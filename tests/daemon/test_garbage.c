@@ -241,6 +241,14 @@ static void invalid_requests(void) {
   CHECK(acc && acc->type == SCP_ACCEPTED, "want ACCEPTED");
   free(acc);
   expect_error(c, &b, SCP_WIRE_DUPLICATE_JOB, "duplicate job");
+  /* An invalid JOB_BEGIN is judged by its id first: one in use is a
+   * duplicate, and 0 claims nothing. */
+  scp_enc_job_begin(&b, &dup);
+  b.data[8 + 8 + 6] = 0xf0; /* r = 1.0 */
+  expect_error(c, &b, SCP_WIRE_DUPLICATE_JOB, "invalid duplicate job");
+  scp_enc_job_begin(&b, &dup);
+  b.data[8] = 0; /* job id 0 */
+  expect_error(c, &b, SCP_WIRE_INVALID, "JOB_BEGIN of job 0");
 
   /* Points out of order. */
   scp_enc_points(&b, 3, 5, SCP_F64_XYZ, sphere, 10);

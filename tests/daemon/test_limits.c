@@ -94,6 +94,25 @@ static void jobs(void) {
         "want a fatal LIMIT, got %s", scp_wire_name(c->last_error.code));
   printf("third job: %s\n", c->last_error.message);
   scdt_close(c);
+
+  /* An invalid JOB_BEGIN beyond the limit is judged by the limit too. */
+  REQUIRE(scdt_open(d.sock, SCP_FRAME_MIN, &c) == 0, "connect");
+  scdt_job_reset(&j1);
+  scdt_job_reset(&j2);
+  CHECK(scdt_job_begin(c, &j1) == 0 && scdt_job_begin(c, &j2) == 0, "send");
+  scp_buf_t b;
+  scp_buf_init(&b, SCP_FRAME_MIN);
+  scp_job_begin_t bad = {.job_id = 3, .mode = 1, .r = 0.25};
+  CHECK(scp_enc_job_begin(&b, &bad) == 0, "encode");
+  b.data[8 + 8 + 6] = 0xf0; /* r = 1.0 */
+  CHECK(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
+  scp_buf_free(&b);
+  CHECK(scdt_wait_closed(c, T_MS), "not closed after too many jobs");
+  CHECK(c->got_error && c->last_error.code == SCP_WIRE_LIMIT &&
+            (c->last_error.flags & SCP_ERROR_FATAL),
+        "invalid third job: want a fatal LIMIT, got %s",
+        scp_wire_name(c->last_error.code));
+  scdt_close(c);
   CHECK_EQ(scdt_stat_wait(d.sock, "jobs_active", 0, T_MS), 0);
 }
 

@@ -510,6 +510,17 @@ static void test_wrong_lengths(void) {
                      .payload = ob.data + SCP_HEADER_SIZE,
                      .length = (uint32_t)(ob.len - SCP_HEADER_SIZE)};
     CHECK_RC(scp_parse(&g, &m), 0);
+    /* Without the JOB_OPTIONS feature, anything past the fixed part is
+     * malformed however it reads; with it, the same as scp_parse(). */
+    scp_job_begin_t jm;
+    CHECK_RC(scp_parse_job_begin_features(&g, SCP_FEATURE_JOB_OPTIONS, &jm),
+             0);
+    CHECK_U64_EQ(jm.options.count, 1);
+    CHECK_RC(scp_parse_job_begin_features(&g, 0, &jm), SCP_ELENGTH);
+    g.length = SCP_JOB_BEGIN_FIXED;
+    CHECK_RC(scp_parse_job_begin_features(&g, 0, &jm), 0);
+    CHECK_U64_EQ(jm.options.count, 0);
+    g.length = (uint32_t)(ob.len - SCP_HEADER_SIZE);
     for (uint32_t n = 41; n < 48; n++) {
       g.length = n;
       CHECK_RC(scp_parse(&g, &m), SCP_ELENGTH);
@@ -526,6 +537,7 @@ static void test_wrong_lengths(void) {
     g.length = 48;
     pt_put32(ob.data + SCP_HEADER_SIZE + 40, 0);
     CHECK_RC(scp_parse(&g, &m), SCP_ERANGE);
+    CHECK_RC(scp_parse_job_begin_features(&g, 0, &jm), SCP_ELENGTH);
     CHECK_INT_EQ(scp_err_is_fatal(SCP_ERANGE), 0);
     /* The encoder refuses an empty view of options that claims entries. */
     jb.options = (scp_values_t){.count = 1, .data = NULL, .len = 0};
