@@ -74,12 +74,7 @@ const char *sc_client_stage_name(uint32_t stage) {
 }
 
 char *sc_client_default_socket(char *buf, size_t len) {
-  const char *xdg = getenv("XDG_RUNTIME_DIR");
-  if (xdg && xdg[0] == '/')
-    snprintf(buf, len, "%s/shortcrust.sock", xdg);
-  else
-    snprintf(buf, len, "/run/shortcrust/shortcrust.sock");
-  return buf;
+  return scp_default_socket(buf, len);
 }
 
 void sc_client_options_init(sc_client_options_t *o) {

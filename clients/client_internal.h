@@ -119,6 +119,16 @@ void scc_drop_mesh(sc_client_job_t *j);
 /* A CANCEL for the job, unless one went out already or its id is free. */
 void scc_queue_cancel(sc_client_t *c, sc_client_job_t *j);
 
+/* client_params.c */
+/* The most job options one job sends: the option rows of the table. */
+#define SCC_MAX_OPTIONS 32
+/* SC_CLIENT_EINVAL, with the reason, for a parameter out of range. */
+int scc_check_params(sc_client_t *c, const sc_client_params_t *p);
+/* The job options of p that are set, into opts (cap entries); returns how
+ * many, in the table's order. */
+uint32_t scc_job_options(const sc_client_params_t *p, scp_value_t *opts,
+                         uint32_t cap);
+
 /* client_results.c */
 /* Calls the job's progress callback; non-zero when it asked to stop. */
 int scc_call_progress(sc_client_t *c, sc_client_job_t *j, uint32_t stage,

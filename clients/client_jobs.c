@@ -9,19 +9,9 @@
 #include "client_internal.h"
 #include "files.h"
 
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define SCC_PI 3.14159265358979323846
-
-void sc_client_params_init(sc_client_params_t *p) {
-  memset(p, 0, sizeof *p);
-  p->mode = SC_CLIENT_MODE_COCONE;
-  p->r = 0.18;
-  p->max_hole_edges = -1;
-}
 
 sc_client_job_t *scc_find_in_use(sc_client_t *c, uint32_t id) {
   for (sc_client_job_t *j = c->jobs; j; j = j->next)
@@ -127,67 +117,6 @@ void scc_queue_cancel(sc_client_t *c, sc_client_job_t *j) {
   }
 }
 
-static int check_params(sc_client_t *c, const sc_client_params_t *p) {
-  if (p->mode < 0 || p->mode >= SCP_MODE_COUNT)
-    return scc_fail(c, SC_CLIENT_EINVAL, "unknown mode %d", p->mode);
-  if (!isfinite(p->r) || p->r <= 0 || p->r >= 0.5)
-    return scc_fail(c, SC_CLIENT_EINVAL, "r must be in (0, 0.5), got %g", p->r);
-  if (!isfinite(p->theta) || p->theta < 0 || p->theta >= SCC_PI / 2)
-    return scc_fail(c, SC_CLIENT_EINVAL,
-                    "theta must be in (0, pi/2) radians, or 0 for the default; "
-                    "got %g",
-                    p->theta);
-  if (p->max_hole_edges < -1 || p->max_hole_edges > 100000)
-    return scc_fail(c, SC_CLIENT_EINVAL,
-                    "max_hole_edges must be in [0, 100000], or -1 for the "
-                    "default; got %d",
-                    p->max_hole_edges);
-  if (!(p->boundary_rho >= 0 && p->boundary_rho <= 10))
-    return scc_fail(
-        c, SC_CLIENT_EINVAL,
-        "boundary_rho must be in (0, 10], or 0 for the default; got "
-        "%g",
-        p->boundary_rho);
-  if (!(p->boundary_alpha >= 0 && p->boundary_alpha <= SCC_PI / 2))
-    return scc_fail(c, SC_CLIENT_EINVAL,
-                    "boundary_alpha must be in (0, pi/2] radians, or 0 for the "
-                    "default; got %g",
-                    p->boundary_alpha);
-  if (p->paper_pruning != 0 && p->paper_pruning != 1)
-    return scc_fail(c, SC_CLIENT_EINVAL, "paper_pruning must be 0 or 1, got %d",
-                    p->paper_pruning);
-  if (p->watertight_labels != 0 && p->watertight_labels != 1)
-    return scc_fail(c, SC_CLIENT_EINVAL,
-                    "watertight_labels must be 0 or 1, got %d",
-                    p->watertight_labels);
-  return 0;
-}
-
-/* The job options of p that differ from the daemon's defaults, into
- * opts[5]; returns how many. */
-static uint32_t job_options(const sc_client_params_t *p, scp_value_t *opts) {
-  uint32_t n = 0;
-  if (p->max_hole_edges >= 0)
-    opts[n++] = (scp_value_t){.name = SCP_OPT_MAX_HOLE_EDGES,
-                              .kind = SCP_KIND_U64,
-                              .v.u = (uint64_t)p->max_hole_edges};
-  if (p->boundary_rho > 0)
-    opts[n++] = (scp_value_t){.name = SCP_OPT_BOUNDARY_RHO,
-                              .kind = SCP_KIND_F64,
-                              .v.f = p->boundary_rho};
-  if (p->boundary_alpha > 0)
-    opts[n++] = (scp_value_t){.name = SCP_OPT_BOUNDARY_ALPHA,
-                              .kind = SCP_KIND_F64,
-                              .v.f = p->boundary_alpha};
-  if (p->paper_pruning)
-    opts[n++] = (scp_value_t){
-        .name = SCP_OPT_PAPER_PRUNING, .kind = SCP_KIND_U64, .v.u = 1};
-  if (p->watertight_labels)
-    opts[n++] = (scp_value_t){
-        .name = SCP_OPT_WATERTIGHT_LABELS, .kind = SCP_KIND_U64, .v.u = 1};
-  return n;
-}
-
 static uint32_t free_id(sc_client_t *c) {
   for (;;) {
     uint32_t id = c->next_id++;
@@ -229,8 +158,8 @@ static int upload(sc_client_t *c, sc_client_job_t *j, const double *xyz) {
     return 0;
   }
   const sc_client_params_t *p = &j->params;
-  scp_value_t opts[5];
-  const uint32_t nopts = job_options(p, opts);
+  scp_value_t opts[SCC_MAX_OPTIONS];
+  const uint32_t nopts = scc_job_options(p, opts, SCC_MAX_OPTIONS);
   if (nopts && !(c->welcome.features & SCP_FEATURE_JOB_OPTIONS)) {
     snprintf(j->message, sizeof j->message,
              "UNSUPPORTED: the daemon does not take job options (%s); "
@@ -300,7 +229,7 @@ static int submit(sc_client_t *c, const sc_client_params_t *params,
     sc_client_params_init(&def);
     params = &def;
   }
-  int rc = check_params(c, params);
+  int rc = scc_check_params(c, params);
   if (rc < 0)
     return rc;
   if (!xyz && n)

@@ -15,9 +15,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* pi / 2, the largest boundary_alpha (M_PI is not C11). */
-#define SCD_HALF_PI 1.5707963267948966
-
 static uint64_t budget_left(const scd_server_t *srv) {
   return srv->budget_used < srv->cfg.memory_budget
              ? srv->cfg.memory_budget - srv->budget_used
@@ -30,70 +27,60 @@ static void fmt_bytes(char *buf, size_t len, uint64_t b) {
 
 /* The job options of a JOB_BEGIN (PROTOCOL.md 6.3), applied to *p: 0, or
  * the wire code to refuse the job with, and the reason in why. */
+/* The row of the core's parameter table that job option name sets, or
+ * NULL; *k is its number. */
+static const sc_param_info_t *option_row(const char *name, size_t *k) {
+  size_t n;
+  const sc_param_info_t *rows = sc_param_table(&n);
+  for (*k = 0; *k < n; ++*k)
+    if (rows[*k].wire == SC_PARAM_OPTION && strcmp(rows[*k].name, name) == 0)
+      return &rows[*k];
+  return NULL;
+}
+
+/* The job options of a JOB_BEGIN (PROTOCOL.md 6.3), applied to *p through
+ * the core's parameter table: 0, or the wire code to refuse the job with,
+ * and the reason in why. */
 static uint32_t apply_options(const scp_values_t *options, sc_params_t *p,
                               char *why, size_t len) {
-  static const struct {
-    const char *name;
-    uint32_t kind;
-  } known[] = {{SCP_OPT_MAX_HOLE_EDGES, SCP_KIND_U64},
-               {SCP_OPT_BOUNDARY_RHO, SCP_KIND_F64},
-               {SCP_OPT_BOUNDARY_ALPHA, SCP_KIND_F64},
-               {SCP_OPT_PAPER_PRUNING, SCP_KIND_U64},
-               {SCP_OPT_WATERTIGHT_LABELS, SCP_KIND_U64}};
-  const size_t nknown = sizeof known / sizeof known[0];
-  unsigned seen = 0;
+  uint64_t seen = 0;
   scp_value_iter_t it;
   scp_value_t v;
   scp_values_begin(options, &it);
   while (scp_values_next(&it, &v)) {
-    size_t k = 0;
-    while (k < nknown && strcmp(v.name, known[k].name) != 0)
-      k++;
-    if (k == nknown) {
+    size_t k;
+    const sc_param_info_t *row = option_row(v.name, &k);
+    if (!row) {
       snprintf(why, len, "job option %s is not supported by this server",
                v.name);
       return SCP_WIRE_UNSUPPORTED;
     }
-    if (seen & (1u << k))
+    if (seen & (1ull << k))
       continue; /* a name given twice takes its first value */
-    seen |= 1u << k;
-    if (v.kind != known[k].kind) {
+    seen |= 1ull << k;
+    int real = row->kind == SC_PARAM_REAL || row->kind == SC_PARAM_ANGLE;
+    if (v.kind != (real ? SCP_KIND_F64 : SCP_KIND_U64)) {
       snprintf(why, len, "job option %s must be %s", v.name,
-               known[k].kind == SCP_KIND_U64 ? "an unsigned integer (u64)"
-                                             : "a number (f64)");
+               real ? "a number (f64)" : "an unsigned integer (u64)");
       return SCP_WIRE_INVALID;
     }
-    int bad = 0;
-    switch (k) {
-    case 0:
-      bad = v.v.u > 100000;
-      p->max_hole_edges = bad ? 0 : (int)v.v.u;
-      break;
-    case 1:
-      bad = !(v.v.f > 0 && v.v.f <= 10);
-      p->boundary_rho = v.v.f;
-      break;
-    case 2:
-      bad = !(v.v.f > 0 && v.v.f <= SCD_HALF_PI);
-      p->boundary_alpha = v.v.f;
-      break;
-    case 3:
-      bad = v.v.u > 1;
-      p->paper_pruning = (int)(v.v.u & 1);
-      break;
-    default:
-      bad = v.v.u > 1;
-      p->watertight_labels = (int)(v.v.u & 1);
-      break;
-    }
-    if (bad) {
-      if (known[k].kind == SCP_KIND_U64)
+    /* On the wire an option is sent only to be used: 0 does not stand for
+     * the default there, as it does in the core's struct. */
+    double num = real ? v.v.f : (double)v.v.u;
+    if (!SC_IN_RANGE(num, row->lo, row->hi,
+                     row->range & ~SC_RANGE_ZERO_DEFAULT)) {
+      if (real)
+        snprintf(why, len, "job option %s out of range: %g", v.name, v.v.f);
+      else
         snprintf(why, len, "job option %s out of range: %llu", v.name,
                  (ull)v.v.u);
-      else
-        snprintf(why, len, "job option %s out of range: %g", v.name, v.v.f);
       return SCP_WIRE_INVALID;
     }
+    void *field = (char *)p + row->offset;
+    if (real)
+      *(double *)field = v.v.f;
+    else
+      *(int *)field = (int)v.v.u;
   }
   /* Whatever the ranges above let through, the core must take too. */
   if (sc_params_check(p, why, len) != SC_OK)

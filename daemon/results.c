@@ -22,68 +22,73 @@ static uint64_t mesh_bytes(const sc_mesh_t *m) {
          m->component_count * sizeof(int32_t);
 }
 
+/* The diagnostics of the core's table, as JOB_DONE values (PROTOCOL.md
+ * 6.12) in the table's order; the arrays' element names go into names. */
+#define SCD_DONE_NAME_MAX 40
+static uint32_t diag_values(const sc_diag_t *d, scp_value_t *v, uint32_t cap,
+                            char (*names)[SCD_DONE_NAME_MAX]) {
+  size_t nrows;
+  const sc_diag_info_t *rows = sc_diag_table(&nrows);
+  uint32_t n = 0;
+  for (size_t r = 0; r < nrows; ++r) {
+    const char *field = (const char *)d + rows[r].offset;
+    for (size_t i = 0; i < rows[r].count && n < cap; ++i, ++n) {
+      const char *suffix = sc_diag_element_name(&rows[r], i);
+      v[n].name = rows[r].wire;
+      if (suffix) {
+        snprintf(names[n], SCD_DONE_NAME_MAX, "%s.%s", rows[r].wire, suffix);
+        v[n].name = names[n];
+      }
+      switch (rows[r].kind) {
+      case SC_DIAG_COUNT:
+      case SC_DIAG_LOOPS:
+        v[n].kind = SCP_KIND_U64;
+        v[n].v.u = ((const uint64_t *)field)[i];
+        break;
+      case SC_DIAG_BOOL:
+        v[n].kind = SCP_KIND_U64;
+        v[n].v.u = *(const int *)field ? 1 : 0;
+        break;
+      case SC_DIAG_PATH:
+        v[n].kind = SCP_KIND_U64;
+        v[n].v.u = (uint64_t)*(const int *)field;
+        break;
+      case SC_DIAG_INT:
+        v[n].kind = SCP_KIND_I64;
+        v[n].v.i = *(const int64_t *)field;
+        break;
+      case SC_DIAG_SECONDS:
+      case SC_DIAG_STAGE_SECONDS:
+        v[n].kind = SCP_KIND_F64;
+        v[n].v.f = ((const double *)field)[i];
+        break;
+      }
+    }
+  }
+  return n;
+}
+
 static void send_job_done(scd_conn_t *c, scd_job_t *j) {
-  const sc_mesh_t *m = j->task->mesh;
-  const sc_diag_t *d = &m->diag;
-#define U(n_, v_) {.name = n_, .kind = SCP_KIND_U64, .v.u = (uint64_t)(v_)}
-#define I(n_, v_) {.name = n_, .kind = SCP_KIND_I64, .v.i = (int64_t)(v_)}
-#define F(n_, v_) {.name = n_, .kind = SCP_KIND_F64, .v.f = (double)(v_)}
-  scp_value_t v[] = {
-      U("points_in", d->points_in),
-      U("duplicates_merged", d->duplicates_merged),
-      U("delaunay_vertices", d->delaunay_vertices),
-      U("delaunay_cells", d->delaunay_cells),
-      U("delaunay_facets", d->delaunay_facets),
-      U("hull_vertices", d->hull_vertices),
-      U("degenerate_cells", d->degenerate_cells),
-      U("candidates", d->candidates),
-      U("pruned", d->pruned),
-      U("triangles", d->triangles),
-      U("walk_rejected", d->walk_rejected),
-      U("holes_filled", d->holes_filled),
-      U("hole_triangles", d->hole_triangles),
-      U("samples_unused", d->samples_unused),
-      U("boundary_edges", d->boundary_edges),
-      U("boundary_loops", d->boundary_loops),
-      U("nonmanifold_edges", d->nonmanifold_edges),
-      U("nonmanifold_vertices", d->nonmanifold_vertices),
-      U("components", d->components),
-      U("closed_components", d->closed_components),
-      U("closed", d->closed ? 1 : 0),
-      I("euler", d->euler),
-      I("genus", d->genus),
-      F("seconds.input", d->seconds[SC_STAGE_INPUT]),
-      F("seconds.delaunay", d->seconds[SC_STAGE_DELAUNAY]),
-      F("seconds.poles", d->seconds[SC_STAGE_POLES]),
-      F("seconds.candidates", d->seconds[SC_STAGE_CANDIDATES]),
-      F("seconds.prune", d->seconds[SC_STAGE_PRUNE]),
-      F("seconds.extract", d->seconds[SC_STAGE_EXTRACT]),
-      F("seconds.total", d->seconds_total),
-      U("path", d->path),
-      U("boundary_samples", d->boundary_samples),
-      U("longest_loop", d->longest_loop),
-      U("loops.3_10", d->loops_by_length[0]),
-      U("loops.11_100", d->loops_by_length[1]),
-      U("loops.101_1000", d->loops_by_length[2]),
-      U("loops.over_1000", d->loops_by_length[3]),
-      U("cells_relabelled", d->cells_relabelled),
-      U("bubbles_dropped", d->bubbles_dropped),
-      U("samples_attached", d->samples_attached),
-      U("handles_cut", d->handles_cut),
-      F("seconds.upload", scd_ms_between(j->begin_ns, j->end_ns) / 1e3),
-      F("seconds.server", scd_ms_between(j->begin_ns, uv_hrtime()) / 1e3),
-  };
-#undef U
-#undef I
-#undef F
+  enum { CAP = 96 };
+  scp_value_t v[CAP];
+  char names[CAP][SCD_DONE_NAME_MAX];
+  uint32_t n = diag_values(&j->task->mesh->diag, v, CAP - 2, names);
+  /* The server's own, about the job rather than the reconstruction. */
+  v[n++] = (scp_value_t){
+      .name = "seconds.upload",
+      .kind = SCP_KIND_F64,
+      .v.f = scd_ms_between(j->begin_ns, j->end_ns) / 1e3};
+  v[n++] = (scp_value_t){
+      .name = "seconds.server",
+      .kind = SCP_KIND_F64,
+      .v.f = scd_ms_between(j->begin_ns, uv_hrtime()) / 1e3};
   scp_job_done_t done;
   memset(&done, 0, sizeof done);
   done.job_id = j->id;
   done.triangles = j->cursor.triangles;
   done.normals = j->cursor.normals;
   done.components = j->cursor.components;
-  scd_conn_sent(c, scp_enc_job_done(&c->out, &done, v,
-                                    (uint32_t)(sizeof v / sizeof v[0])));
+  scd_conn_sent(c, scp_enc_job_done(&c->out, &done, v, n));
 }
 
 /* Emits mesh chunks, one job after the other in turn, while the output
