@@ -32,14 +32,14 @@ void scct_check_mesh(const char *what, int surface, const double *xyz,
     return;
   CHECK_EQ(m.point_count, n);
   CHECK(m.triangles != NULL, "%s: no triangles kept", what);
-  sc_meshcheck_t mc;
-  REQUIRE(sc_meshcheck((size_t)n, xyz, m.triangles, (size_t)m.triangle_count,
-                       NULL, &mc) == SC_TS_OK,
+  scs_meshcheck_t mc;
+  REQUIRE(scs_meshcheck((size_t)n, xyz, m.triangles, (size_t)m.triangle_count,
+                        NULL, &mc) == SCS_OK,
           "%s: mesh check", what);
   char why[512] = "", sum[512];
-  CHECK(sc_meshcheck_expect(&mc, (sc_surface_t)surface, SC_EXPECT_OUTWARD, why,
-                            sizeof why),
-        "%s: %s; %s", what, why, sc_meshcheck_summary(&mc, sum, sizeof sum));
+  CHECK(scs_meshcheck_expect(&mc, (scs_surface_t)surface, SCS_EXPECT_OUTWARD,
+                             why, sizeof why),
+        "%s: %s; %s", what, why, scs_meshcheck_summary(&mc, sum, sizeof sum));
   /* What the daemon says about the mesh is what arrived. */
   CHECK_EQ(sc_client_value_get(m.values, m.value_count, "triangles", -1),
            m.triangle_count);
@@ -55,5 +55,5 @@ void scct_check_mesh(const char *what, int surface, const double *xyz,
             m.seconds_upload <= m.seconds_total,
         "%s: times upload %g total %g", what, m.seconds_upload,
         m.seconds_total);
-  sc_meshcheck_free(&mc);
+  scs_meshcheck_free(&mc);
 }

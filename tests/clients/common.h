@@ -12,7 +12,7 @@
 
 #include "harness.h"
 #include "shortcrust_client.h"
-#include "testsupport.h"
+#include "synth.h"
 
 /* Generous: sanitizer builds run the core many times slower. */
 #define SCCT_WAIT_MS 300000

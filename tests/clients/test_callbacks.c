@@ -103,7 +103,7 @@ static void progress(void) {
   /* Big enough that the daemon reports its stages (at most ten times a
    * second), small enough for a sanitizer build. */
   const uint64_t n = 40000;
-  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 5);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, n, 5);
   sc_client_t *c = scct_open(d.sock, 0);
   seen_t s;
   memset(&s, 0, sizeof s);
@@ -128,7 +128,7 @@ static void progress(void) {
         "download: %u calls, last fraction %g", s.download, s.last_download);
   CHECK(!s.out_of_order, "progress out of order");
   CHECK_EQ(s.reentry_rc, SC_CLIENT_ESTATE);
-  scct_check_mesh("sphere with progress", SC_SURF_SPHERE, xyz, n, j);
+  scct_check_mesh("sphere with progress", SCS_SURF_SPHERE, xyz, n, j);
   sc_client_job_free(j);
   sc_client_free(c);
   free(xyz);
@@ -136,7 +136,7 @@ static void progress(void) {
 
 static void chunks(void) {
   const uint64_t n = 5000;
-  double *xyz = scdt_sample(SC_SURF_GENUS2, n, 6);
+  double *xyz = scdt_sample(SCS_SURF_GENUS2, n, 6);
   /* The smallest frames: the mesh comes in many chunks. */
   sc_client_t *c = scct_open(d.sock, 4096);
   sc_client_params_t p;
@@ -155,7 +155,7 @@ static void chunks(void) {
           sc_client_last_error(c));
   CHECK_EQ(sc_client_wait(c, whole, SCCT_WAIT_MS), 0);
   CHECK_EQ(sc_client_wait(c, parts, SCCT_WAIT_MS), 0);
-  scct_check_mesh("genus 2, buffered", SC_SURF_GENUS2, xyz, n, whole);
+  scct_check_mesh("genus 2, buffered", SCS_SURF_GENUS2, xyz, n, whole);
 
   sc_client_mesh_t a, b;
   CHECK_EQ(sc_client_job_mesh(whole, &a), 0);
@@ -174,15 +174,15 @@ static void chunks(void) {
   CHECK_EQ(k.ncomp, a.component_count);
   /* The same daemon, the same points: the same mesh either way, as a set
    * of triangles (their order may differ from run to run). */
-  sc_meshcheck_t mc;
-  REQUIRE(sc_meshcheck((size_t)n, xyz, k.tri, (size_t)k.ntri, NULL, &mc) ==
-              SC_TS_OK,
+  scs_meshcheck_t mc;
+  REQUIRE(scs_meshcheck((size_t)n, xyz, k.tri, (size_t)k.ntri, NULL, &mc) ==
+              SCS_OK,
           "mesh check");
   char why[256] = "";
-  CHECK(sc_meshcheck_expect(&mc, SC_SURF_GENUS2, SC_EXPECT_OUTWARD, why,
-                            sizeof why),
+  CHECK(scs_meshcheck_expect(&mc, SCS_SURF_GENUS2, SCS_EXPECT_OUTWARD, why,
+                             sizeof why),
         "chunked mesh: %s", why);
-  sc_meshcheck_free(&mc);
+  scs_meshcheck_free(&mc);
   CHECK(k.genus && a.genus &&
             memcmp(k.genus, a.genus, (size_t)k.ncomp * sizeof(int32_t)) == 0,
         "genera differ");

@@ -21,8 +21,8 @@ static scdt_daemon_t d;
  * and slow to reconstruct. */
 static double *big_sample(uint64_t n) {
   double *xyz = malloc((size_t)n * 3 * sizeof(double));
-  REQUIRE(xyz && sc_sample_surface(SC_SURF_SPHERE, SC_DENSITY_UNIFORM_RANDOM,
-                                   (size_t)n, 77, xyz) == SC_TS_OK,
+  REQUIRE(xyz && scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM_RANDOM,
+                                    (size_t)n, 77, xyz) == SCS_OK,
           "sample");
   return xyz;
 }
@@ -30,13 +30,13 @@ static double *big_sample(uint64_t n) {
 /* A small job must still come out right on the same connection. */
 static void check_serving(sc_client_t *c, const char *when) {
   const uint64_t n = 2000;
-  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 3);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, n, 3);
   sc_client_job_t *j;
   int rc = sc_client_submit(c, NULL, xyz, n, &j);
   CHECK(rc == 0, "%s: submit: %s", when, sc_client_last_error(c));
   if (rc == 0) {
     CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), 0);
-    scct_check_mesh(when, SC_SURF_SPHERE, xyz, n, j);
+    scct_check_mesh(when, SCS_SURF_SPHERE, xyz, n, j);
     sc_client_job_free(j);
   }
   free(xyz);
@@ -126,7 +126,7 @@ static int stop_download(void *user, sc_client_job_t *job, int array,
 
 static void during_download(void) {
   const uint64_t n = 20000;
-  double *xyz = scdt_sample(SC_SURF_TORUS, n, 8);
+  double *xyz = scdt_sample(SCS_SURF_TORUS, n, 8);
   sc_client_t *c = scct_open(d.sock, 4096);
   unsigned calls = 0;
   sc_client_params_t p;

@@ -115,7 +115,7 @@ static void refused(void) {
   CHECK_EQ(info.max_points, 1000);
   CHECK_EQ(info.max_jobs, 2);
   const uint64_t n = 3000;
-  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 1);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, n, 1);
   sc_client_job_t *j;
   /* Too many points: refused, and why. */
   CHECK_EQ(sc_client_submit(c, NULL, xyz, n, &j), 0);
@@ -201,7 +201,7 @@ static void failed_and_invalid(void) {
   sc_client_job_free(j);
 
   /* A NaN. */
-  double *xyz = scdt_sample(SC_SURF_SPHERE, 500, 2);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, 500, 2);
   xyz[3 * 17 + 1] = NAN;
   CHECK_EQ(sc_client_submit(c, NULL, xyz, 500, &j), 0);
   CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), SC_CLIENT_EFAILED);
@@ -255,7 +255,7 @@ static void connection_lost(void) {
   REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
   sc_client_t *c = scct_open(d.sock, 0);
   const uint64_t n = 50000;
-  double *xyz = scdt_sample(SC_SURF_TORUS, n, 4);
+  double *xyz = scdt_sample(SCS_SURF_TORUS, n, 4);
   sc_client_params_t p;
   sc_client_params_init(&p);
   struct killer killer = {&d, 0};
@@ -298,8 +298,8 @@ static void shutdown_(void) {
   sc_client_t *c = scct_open(d.sock, 0);
   const uint64_t n = 200000;
   double *xyz = malloc(n * 3 * sizeof(double));
-  REQUIRE(xyz && sc_sample_surface(SC_SURF_SPHERE, SC_DENSITY_UNIFORM_RANDOM, n,
-                                   9, xyz) == SC_TS_OK,
+  REQUIRE(xyz && scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM_RANDOM,
+                                    n, 9, xyz) == SCS_OK,
           "sample");
   sc_client_job_t *j;
   CHECK_EQ(sc_client_submit(c, NULL, xyz, n, &j), 0);

@@ -22,7 +22,7 @@ static const char *datadir;
 static void from_array(void) {
   sc_client_t *c = scct_open(d.sock, 0);
   const uint64_t n = 3000;
-  double *xyz = scdt_sample(SC_SURF_TORUS, n, 1);
+  double *xyz = scdt_sample(SCS_SURF_TORUS, n, 1);
   sc_client_params_t p;
   sc_client_params_init(&p);
   sc_client_job_t *j = NULL;
@@ -37,7 +37,7 @@ static void from_array(void) {
   CHECK(strcmp(sc_client_job_message(j), "") == 0, "message '%s'",
         sc_client_job_message(j));
   CHECK_EQ(sc_client_job_server_code(j), 0);
-  scct_check_mesh("torus from an array", SC_SURF_TORUS, xyz, n, j);
+  scct_check_mesh("torus from an array", SCS_SURF_TORUS, xyz, n, j);
   uint64_t m;
   CHECK(sc_client_job_points(j, &m) == NULL && m == 0,
         "an array job has no points of its own");
@@ -52,7 +52,7 @@ static void from_array(void) {
   rc = sc_client_submit(c, &p, xyz, n, &j);
   REQUIRE(rc == 0, "submit: %s", sc_client_last_error(c));
   CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), 0);
-  scct_check_mesh("torus, shortcrust, normals", SC_SURF_TORUS, xyz, n, j);
+  scct_check_mesh("torus, shortcrust, normals", SCS_SURF_TORUS, xyz, n, j);
   sc_client_mesh_t mesh;
   sc_client_job_mesh(j, &mesh);
   CHECK_EQ(mesh.normal_count, n);
@@ -87,16 +87,16 @@ static void from_file(void) {
         "the job's points are not the file's");
   sc_client_mesh_t m;
   CHECK_EQ(sc_client_job_mesh(j, &m), 0);
-  sc_meshcheck_t mc;
-  REQUIRE(sc_meshcheck(pts.count, pts.xyz, m.triangles,
-                       (size_t)m.triangle_count, NULL, &mc) == SC_TS_OK,
+  scs_meshcheck_t mc;
+  REQUIRE(scs_meshcheck(pts.count, pts.xyz, m.triangles,
+                        (size_t)m.triangle_count, NULL, &mc) == SCS_OK,
           "mesh check");
   char sum[512];
   /* The knot is a closed surface of genus 1 (tests/cli says the same of
    * the local command). */
   CHECK(mc.closed && mc.oriented && mc.components == 1 && mc.genus_total == 1,
-        "knot: %s", sc_meshcheck_summary(&mc, sum, sizeof sum));
-  sc_meshcheck_free(&mc);
+        "knot: %s", scs_meshcheck_summary(&mc, sum, sizeof sum));
+  scs_meshcheck_free(&mc);
   sc_client_job_free(j);
 
   /* A text file written here: the same points, the same triangles. */
@@ -137,8 +137,9 @@ static void many_in_flight(void) {
    * chunks. */
   sc_client_t *c = scct_open(d.sock, 4096);
   enum { NJ = 6 };
-  static const int surf[NJ] = {SC_SURF_SPHERE, SC_SURF_TORUS, SC_SURF_GENUS2,
-                               SC_SURF_SPHERE, SC_SURF_TORUS, SC_SURF_GENUS2};
+  static const int surf[NJ] = {SCS_SURF_SPHERE, SCS_SURF_TORUS,
+                               SCS_SURF_GENUS2, SCS_SURF_SPHERE,
+                               SCS_SURF_TORUS,  SCS_SURF_GENUS2};
   double *xyz[NJ];
   uint64_t n[NJ];
   sc_client_job_t *j[NJ];

@@ -32,7 +32,7 @@ static int check_failures;
 
 /* The counts a reconstruction reports in its diagnostics (d, an
  * sc_diag_t) against those the mesh checker finds in the mesh (c, an
- * sc_meshcheck_t); the core keeps some of them up to date as it edits the
+ * scs_meshcheck_t); the core keeps some of them up to date as it edits the
  * surface instead of counting again. */
 #define CHECK_DIAG_COUNTS(d, c)                                                \
   do {                                                                         \

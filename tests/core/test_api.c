@@ -10,7 +10,7 @@
 
 #include "check.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 enum { N = 6000 };
 
@@ -121,7 +121,7 @@ int main(void) {
   }
 
   double *xyz = malloc(3 * N * sizeof *xyz);
-  sc_sample_surface(SC_SURF_TORUS, SC_DENSITY_UNIFORM, N, 11, xyz);
+  scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, N, 11, xyz);
   sc_params_t p;
   sc_params_init(&p);
   char msg[256];

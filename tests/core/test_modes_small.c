@@ -14,7 +14,7 @@
 
 #include "check.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 static void run(const char *what, const double *xyz, size_t n, int mode) {
   sc_params_t p;
@@ -29,12 +29,12 @@ static void run(const char *what, const double *xyz, size_t n, int mode) {
     ++check_failures;
     return;
   }
-  sc_meshcheck_t c;
-  CHECK_EQ_INT(sc_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
+  scs_meshcheck_t c;
+  CHECK_EQ_INT(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
                0);
   char line[512];
   printf("%s, mode %d, path %s: %s\n", what, mode, sc_path_name(m->diag.path),
-         sc_meshcheck_summary(&c, line, sizeof line));
+         scs_meshcheck_summary(&c, line, sizeof line));
   CHECK(c.manifold);
   CHECK(c.oriented);
   CHECK_EQ_INT(m->diag.nonmanifold_edges, 0);
@@ -51,13 +51,13 @@ static void run(const char *what, const double *xyz, size_t n, int mode) {
     if (n == 8)
       CHECK_EQ_INT(c.faces, 12);
   }
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
   sc_mesh_free(m);
 }
 
 int main(void) {
   const int modes[] = {SC_MODE_BOUNDARY, SC_MODE_WATERTIGHT, SC_MODE_AUTO};
-  sc_rng_t rng;
+  scs_rng_t rng;
   double *xyz = malloc(3 * 2000 * sizeof *xyz);
   if (!xyz)
     return 1;
@@ -73,29 +73,31 @@ int main(void) {
         cube[3 * i + k] = (i >> k) & 1;
     run("cube corners", cube, 8, mode);
 
-    sc_rng_seed(&rng, 11);
+    scs_rng_seed(&rng, 11);
     for (int i = 0; i < 30; ++i) {
-      double z = 2 * sc_rng_uniform(&rng) - 1, t = 6.283185307 * sc_rng_uniform(&rng);
+      double z = 2 * scs_rng_uniform(&rng) - 1,
+             t = 6.283185307 * scs_rng_uniform(&rng);
       double r = sqrt(1 - z * z);
       xyz[3 * i] = r * cos(t), xyz[3 * i + 1] = r * sin(t), xyz[3 * i + 2] = z;
     }
     run("30 points on a sphere", xyz, 30, mode);
 
     for (int i = 0; i < 500; ++i) {
-      xyz[3 * i] = sc_rng_uniform(&rng);
-      xyz[3 * i + 1] = sc_rng_uniform(&rng);
-      xyz[3 * i + 2] = 0.01 * sc_rng_uniform(&rng);
+      xyz[3 * i] = scs_rng_uniform(&rng);
+      xyz[3 * i + 1] = scs_rng_uniform(&rng);
+      xyz[3 * i + 2] = 0.01 * scs_rng_uniform(&rng);
     }
     run("noisy flat slab", xyz, 500, mode);
 
     for (int i = 0; i < 1000; ++i)
       for (int k = 0; k < 3; ++k)
-        xyz[3 * i + k] = sc_rng_uniform(&rng);
+        xyz[3 * i + k] = scs_rng_uniform(&rng);
     run("cloud filling a cube", xyz, 1000, mode);
 
     /* Two unit squares crossing at right angles along the x axis. */
     for (int i = 0; i < 1000; ++i) {
-      double u = 2 * sc_rng_uniform(&rng) - 1, v = 2 * sc_rng_uniform(&rng) - 1;
+      double u = 2 * scs_rng_uniform(&rng) - 1,
+             v = 2 * scs_rng_uniform(&rng) - 1;
       xyz[3 * i] = u;
       xyz[3 * i + 1] = i % 2 ? v : 0.001 * v;
       xyz[3 * i + 2] = i % 2 ? 0.001 * v : v;

@@ -27,6 +27,7 @@
 
 #include "check.h"
 #include "shortcrust.h"
+#include "synth.h"
 #include "testsupport.h"
 
 #define PI 3.14159265358979323846
@@ -83,8 +84,8 @@ static double dist3(const double *a, const double *b) {
 
 /* One area-uniform random point of surface s (the wavy disc is uniform in
  * the plane, which its gentle slope makes nearly uniform in area). */
-static void open_point(int s, sc_rng_t *rng, double p[3]) {
-  double u = sc_rng_uniform(rng), v = sc_rng_uniform(rng);
+static void open_point(int s, scs_rng_t *rng, double p[3]) {
+  double u = scs_rng_uniform(rng), v = scs_rng_uniform(rng);
   switch (s) {
   case HOLED_TORUS:
     /* The tube angle by rejection against the area element, then outside
@@ -93,10 +94,10 @@ static void open_point(int s, sc_rng_t *rng, double p[3]) {
       double t = 2 * PI * u, f = 2 * PI * v;
       double w = TOR_R + TOR_r * cos(f);
       p[0] = w * cos(t), p[1] = w * sin(t), p[2] = TOR_r * sin(f);
-      if (sc_rng_uniform(rng) * (TOR_R + TOR_r) <= w &&
+      if (scs_rng_uniform(rng) * (TOR_R + TOR_r) <= w &&
           dist3(p, HOLE_C) > HOLE_R)
         return;
-      u = sc_rng_uniform(rng), v = sc_rng_uniform(rng);
+      u = scs_rng_uniform(rng), v = scs_rng_uniform(rng);
     }
   case HEMISPHERE:
   case CUT_SPHERE: {
@@ -158,8 +159,8 @@ static size_t sample_open(int s, size_t n, uint64_t seed, double spacing,
   }
   for (size_t i = 0; i < (size_t)g * g * g; ++i)
     head[i] = -1;
-  sc_rng_t rng;
-  sc_rng_seed(&rng, seed);
+  scs_rng_t rng;
+  scs_rng_seed(&rng, seed);
   for (size_t tries = 0; tries < 40 * n && count < cap; ++tries) {
     double p[3];
     open_point(s, &rng, p);
@@ -272,22 +273,22 @@ int main(int argc, char **argv) {
   p.watertight_labels = labels;
   sc_mesh_t *m = NULL;
   char msg[256] = "";
-  double t0 = sc_ts_seconds();
+  double t0 = sct_seconds();
   int rc = sc_reconstruct(xyz, n, &p, &m, msg, sizeof msg);
-  double t1 = sc_ts_seconds();
+  double t1 = sct_seconds();
   CHECK_EQ_INT(rc, 0);
   if (rc != 0) {
     fprintf(stderr, "%s\n", msg);
     free(xyz);
     return CHECK_DONE();
   }
-  sc_meshcheck_t c;
-  CHECK_EQ_INT(sc_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
+  scs_meshcheck_t c;
+  CHECK_EQ_INT(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
                0);
   char line[512];
   printf("%s %s n=%zu: %s path=%s boundary_samples=%llu holes=%llu/%llu "
          "handles_cut=%llu (%.2f s)\n",
-         argv[1], argv[2], n, sc_meshcheck_summary(&c, line, sizeof line),
+         argv[1], argv[2], n, scs_meshcheck_summary(&c, line, sizeof line),
          sc_path_name(m->diag.path),
          (unsigned long long)m->diag.boundary_samples,
          (unsigned long long)m->diag.holes_filled,
@@ -342,7 +343,7 @@ int main(int argc, char **argv) {
      * apart along the curve; but they are loops, not slivers. */
     CHECK(m->diag.longest_loop >= 8);
   }
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
   sc_mesh_free(m);
   free(xyz);
   return CHECK_DONE();

@@ -14,7 +14,7 @@
 #include "check.h"
 #include "files.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 int main(int argc, char **argv) {
   if (argc != 3 && argc != 4) {
@@ -47,13 +47,13 @@ int main(int argc, char **argv) {
     fprintf(stderr, "%s\n", msg);
     return CHECK_DONE();
   }
-  sc_meshcheck_t c;
-  CHECK_EQ_INT(sc_meshcheck(pts.count, pts.xyz, m->triangles,
-                            m->triangle_count, NULL, &c),
+  scs_meshcheck_t c;
+  CHECK_EQ_INT(scs_meshcheck(pts.count, pts.xyz, m->triangles,
+                             m->triangle_count, NULL, &c),
                0);
   char line[512];
   printf("%s %s: %s; handles cut %llu\n", argv[1], argc == 4 ? argv[3] : "",
-         sc_meshcheck_summary(&c, line, sizeof line),
+         scs_meshcheck_summary(&c, line, sizeof line),
          (unsigned long long)m->diag.handles_cut);
   CHECK(c.manifold);
   CHECK(c.closed);
@@ -66,7 +66,7 @@ int main(int argc, char **argv) {
   CHECK_EQ_INT(m->diag.genus, genus);
   CHECK(m->diag.closed);
   CHECK_DIAG_COUNTS(m->diag, c);
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
   sc_mesh_free(m);
   sc_points_free(&pts);
   return CHECK_DONE();

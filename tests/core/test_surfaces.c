@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "shortcrust.h"
+#include "synth.h"
 #include "testsupport.h"
 
 static int mode_from_name(const char *s) {
@@ -36,8 +37,8 @@ int main(int argc, char **argv) {
     fprintf(stderr, "usage: %s SURFACE DENSITY MODE N [SEED [R]]\n", argv[0]);
     return 2;
   }
-  int surf = sc_surface_from_name(argv[1]);
-  int dens = sc_density_from_name(argv[2]);
+  int surf = scs_surface_from_name(argv[1]);
+  int dens = scs_density_from_name(argv[2]);
   int mode = mode_from_name(argv[3]);
   size_t n = strtoul(argv[4], NULL, 10);
   uint64_t seed = argc > 5 ? strtoull(argv[5], NULL, 10) : 1;
@@ -47,7 +48,7 @@ int main(int argc, char **argv) {
   }
 
   double *xyz = malloc(3 * n * sizeof *xyz);
-  if (!xyz || sc_sample_surface(surf, dens, n, seed, xyz) != 0) {
+  if (!xyz || scs_sample_surface(surf, dens, n, seed, xyz) != 0) {
     fprintf(stderr, "sampling failed\n");
     return 1;
   }
@@ -58,9 +59,9 @@ int main(int argc, char **argv) {
     params.r = strtod(argv[6], NULL);
   sc_mesh_t *mesh = NULL;
   char msg[256] = "";
-  double t0 = sc_ts_seconds();
+  double t0 = sct_seconds();
   int rc = sc_reconstruct(xyz, n, &params, &mesh, msg, sizeof msg);
-  double t1 = sc_ts_seconds();
+  double t1 = sct_seconds();
   if (rc != 0) {
     fprintf(stderr, "FAIL: sc_reconstruct returned %d (%s): %s\n", rc,
             sc_err_name(rc), msg);
@@ -68,23 +69,22 @@ int main(int argc, char **argv) {
   }
 
   int failures = 0;
-  sc_meshcheck_t c;
-  if (sc_meshcheck(n, xyz, mesh->triangles, mesh->triangle_count, NULL, &c)) {
+  scs_meshcheck_t c;
+  if (scs_meshcheck(n, xyz, mesh->triangles, mesh->triangle_count, NULL, &c)) {
     fprintf(stderr, "meshcheck failed\n");
     return 1;
   }
   char line[512];
   printf("%s %s %s n=%zu: %s (%.2f s)\n", argv[1], argv[2], argv[3], n,
-         sc_meshcheck_summary(&c, line, sizeof line), t1 - t0);
+         scs_meshcheck_summary(&c, line, sizeof line), t1 - t0);
   char why[256];
   /* The modes for scans may leave out a sample or two where the boundary
    * detection sees undersampling (at most one in a thousand). */
   const int scan_mode = mode == SC_MODE_BOUNDARY ||
                         mode == SC_MODE_WATERTIGHT || mode == SC_MODE_AUTO;
-  if (!sc_meshcheck_expect(&c, surf,
-                           (scan_mode ? 0u : SC_EXPECT_ALL_USED) |
-                               SC_EXPECT_OUTWARD,
-                           why, sizeof why)) {
+  if (!scs_meshcheck_expect(
+          &c, surf, (scan_mode ? 0u : SCS_EXPECT_ALL_USED) | SCS_EXPECT_OUTWARD,
+          why, sizeof why)) {
     fprintf(stderr, "FAIL: %s\n", why);
     ++failures;
   }
@@ -118,9 +118,9 @@ int main(int argc, char **argv) {
   }
 
   /* Vertices are samples, so they lie on the surface to rounding error. */
-  sc_distcheck_t dc;
-  if (sc_mesh_distance_check(surf, n, xyz, mesh->triangles,
-                             mesh->triangle_count, 1e-9, &dc) != 0 ||
+  scs_distcheck_t dc;
+  if (scs_mesh_distance_check(surf, n, xyz, mesh->triangles,
+                              mesh->triangle_count, 1e-9, &dc) != 0 ||
       dc.beyond != 0) {
     fprintf(stderr, "FAIL: %llu vertices off the surface (max %g)\n",
             (unsigned long long)dc.beyond, dc.max_distance);
@@ -133,7 +133,7 @@ int main(int argc, char **argv) {
     const double *nv = mesh->normals + 3 * i;
     double len = sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
     double truth[3];
-    sc_surface_normal(surf, xyz + 3 * i, truth);
+    scs_surface_normal(surf, xyz + 3 * i, truth);
     double dot = nv[0] * truth[0] + nv[1] * truth[1] + nv[2] * truth[2];
     if (fabs(len - 1) > 1e-9 || dot < 0.5)
       ++bad_normals;
@@ -154,7 +154,7 @@ int main(int argc, char **argv) {
     ++failures;
   }
 
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
   sc_mesh_free(mesh);
   free(xyz);
   return failures ? 1 : 0;

@@ -17,7 +17,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "testsupport.h"
+#include "synth.h"
 
 atomic_int scdt_failures;
 
@@ -253,8 +253,8 @@ static double *sample(int surface, int density, size_t n, uint64_t seed) {
   double *xyz = malloc(n * 3 * sizeof(double));
   if (!xyz)
     return NULL;
-  if (sc_sample_surface((sc_surface_t)surface, density, n, seed, xyz) !=
-      SC_TS_OK) {
+  if (scs_sample_surface((scs_surface_t)surface, density, n, seed, xyz) !=
+      SCS_OK) {
     free(xyz);
     return NULL;
   }
@@ -262,11 +262,11 @@ static double *sample(int surface, int density, size_t n, uint64_t seed) {
 }
 
 double *scdt_sample(int surface, size_t n, uint64_t seed) {
-  return sample(surface, SC_DENSITY_UNIFORM, n, seed);
+  return sample(surface, SCS_DENSITY_UNIFORM, n, seed);
 }
 
 double *scdt_sample_random(int surface, size_t n, uint64_t seed) {
-  return sample(surface, SC_DENSITY_UNIFORM_RANDOM, n, seed);
+  return sample(surface, SCS_DENSITY_UNIFORM_RANDOM, n, seed);
 }
 
 void scdt_run_ok(scdt_conn_t *c, uint32_t id, int surface, const double *xyz,
@@ -299,20 +299,19 @@ int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {
              scp_wire_name(j->error_code), j->error_msg);
     return 0;
   }
-  sc_meshcheck_t mc;
-  if (sc_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SC_TS_OK) {
+  scs_meshcheck_t mc;
+  if (scs_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SCS_OK) {
     snprintf(why, len, "job %u: mesh check failed to run", j->id);
     return 0;
   }
   char reason[512];
-  int ok = sc_meshcheck_expect(&mc, (sc_surface_t)surface, SC_EXPECT_OUTWARD,
-                               reason, sizeof reason);
+  int ok = scs_meshcheck_expect(&mc, (scs_surface_t)surface, SCS_EXPECT_OUTWARD,
+                                reason, sizeof reason);
   if (!ok) {
     char sum[512];
     snprintf(why, len, "job %u (%s, %llu points): %s; %s", j->id,
-             sc_surface_name((sc_surface_t)surface),
-             (unsigned long long)j->n, reason,
-             sc_meshcheck_summary(&mc, sum, sizeof sum));
+             scs_surface_name((scs_surface_t)surface), (unsigned long long)j->n,
+             reason, scs_meshcheck_summary(&mc, sum, sizeof sum));
   } else if (j->diag_triangles != j->ntri) {
     snprintf(why, len, "job %u: JOB_DONE diagnostics say %llu triangles, "
              "%llu came",
@@ -324,7 +323,7 @@ int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {
              j->id, (long long)j->diag_genus, (long long)mc.genus_total);
     ok = 0;
   }
-  sc_meshcheck_free(&mc);
+  scs_meshcheck_free(&mc);
   return ok;
 }
 
@@ -334,8 +333,8 @@ int scdt_mesh_closed(const scdt_job_t *j, char *why, size_t len) {
              scp_wire_name(j->error_code), j->error_msg);
     return 0;
   }
-  sc_meshcheck_t mc;
-  if (sc_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SC_TS_OK) {
+  scs_meshcheck_t mc;
+  if (scs_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SCS_OK) {
     snprintf(why, len, "job %u: mesh check failed to run", j->id);
     return 0;
   }
@@ -343,9 +342,9 @@ int scdt_mesh_closed(const scdt_job_t *j, char *why, size_t len) {
   if (!ok) {
     char sum[512];
     snprintf(why, len, "job %u: not a closed oriented manifold: %s", j->id,
-             sc_meshcheck_summary(&mc, sum, sizeof sum));
+             scs_meshcheck_summary(&mc, sum, sizeof sum));
   }
-  sc_meshcheck_free(&mc);
+  scs_meshcheck_free(&mc);
   return ok;
 }
 

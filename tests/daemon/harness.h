@@ -95,7 +95,7 @@ int scdt_log_wait(const scdt_daemon_t *d, const char *text, int timeout_ms);
 /* Counts lines of the log containing the text. */
 int scdt_log_count(const scdt_daemon_t *d, const char *text);
 
-/* Well-spaced samples of a test surface (sc_surface_t), malloc'd. */
+/* Well-spaced samples of a test surface (scs_surface_t), malloc'd. */
 double *scdt_sample(int surface, size_t n, uint64_t seed);
 /* Independent uniform samples: much quicker to make, for jobs that are
  * meant to be stopped rather than checked. */

@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "harness.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 120000
 
@@ -29,16 +29,16 @@ static void check_idle(const char *when) {
 
 /* A job must still come out right on a fresh connection. */
 static void check_serving(const char *when) {
-  double *xyz = scdt_sample(SC_SURF_SPHERE, 2000, 99);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, 2000, 99);
   REQUIRE(xyz != NULL, "%s: sample", when);
-  scdt_check_serving(d.sock, SC_SURF_SPHERE, xyz, 2000, T_MS, when);
+  scdt_check_serving(d.sock, SCS_SURF_SPHERE, xyz, 2000, T_MS, when);
   free(xyz);
 }
 
 static void cancel_during_upload(void) {
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, 1u << 20, &c) == 0, "connect");
-  double *xyz = scdt_sample(SC_SURF_TORUS, 3000, 3);
+  double *xyz = scdt_sample(SCS_SURF_TORUS, 3000, 3);
   scdt_job_t j;
   scdt_job_init(&j, 7, xyz, 3000);
   scdt_job_t *pj = &j;
@@ -53,7 +53,7 @@ static void cancel_during_upload(void) {
   scdt_job_reset(&j);
   CHECK(scdt_job_send(c, &j) == 0, "resend");
   CHECK(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s", why);
-  CHECK(scdt_mesh_ok(SC_SURF_TORUS, &j, why, sizeof why), "%s", why);
+  CHECK(scdt_mesh_ok(SCS_SURF_TORUS, &j, why, sizeof why), "%s", why);
   scdt_job_reset(&j);
   /* CANCEL for an id not in use is not an error: the PING's PONG is the
    * next frame. */
@@ -73,7 +73,7 @@ static void cancel_while_running(void) {
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, 1u << 20, &c) == 0, "connect");
   size_t n = 40000;
-  double *xyz = scdt_sample_random(SC_SURF_SPHERE, n, 4);
+  double *xyz = scdt_sample_random(SCS_SURF_SPHERE, n, 4);
   scdt_job_t j;
   scdt_job_init(&j, 8, xyz, n);
   scdt_job_t *pj = &j;
@@ -100,7 +100,7 @@ static void cancel_while_running(void) {
 static void disconnect_during_upload(void) {
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, SCP_FRAME_MIN, &c) == 0, "connect");
-  double *xyz = scdt_sample(SC_SURF_SPHERE, 3000, 5);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, 3000, 5);
   scdt_job_t a, b;
   scdt_job_init(&a, 1, xyz, 3000);
   scdt_job_init(&b, 2, xyz, 3000);
@@ -133,7 +133,7 @@ static void disconnect_while_running(void) {
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, 1u << 20, &c) == 0, "connect");
   size_t n = 40000;
-  double *xyz = scdt_sample_random(SC_SURF_SPHERE, n, 6);
+  double *xyz = scdt_sample_random(SCS_SURF_SPHERE, n, 6);
   scdt_job_t j;
   scdt_job_init(&j, 9, xyz, n);
   CHECK(scdt_job_send(c, &j) == 0, "send");
@@ -146,7 +146,7 @@ static void disconnect_while_running(void) {
 static void disconnect_during_download(void) {
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, SCP_FRAME_MIN, &c) == 0, "connect");
-  double *xyz = scdt_sample(SC_SURF_GENUS2, 4000, 7);
+  double *xyz = scdt_sample(SCS_SURF_GENUS2, 4000, 7);
   scdt_job_t j;
   scdt_job_init(&j, 10, xyz, 4000);
   j.flags = SCP_JOB_NORMALS | SCP_JOB_NORMALS_F64;

@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "harness.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 120000
 
@@ -21,7 +21,7 @@ static scdt_daemon_t d;
 static double *sphere; /* 3000 points */
 
 static void check_serving(const char *when) {
-  scdt_check_serving(d.sock, SC_SURF_SPHERE, sphere, 3000, T_MS, when);
+  scdt_check_serving(d.sock, SCS_SURF_SPHERE, sphere, 3000, T_MS, when);
 }
 
 /* Sends raw bytes on a fresh connection (before any handshake unless
@@ -269,7 +269,7 @@ static void invalid_requests(void) {
   CHECK(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s", why);
   CHECK(c->got_error && c->last_error.code == SCP_WIRE_STATE,
         "want ERROR STATE, got %s", scp_wire_name(c->last_error.code));
-  CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &j, why, sizeof why), "%s", why);
+  CHECK(scdt_mesh_ok(SCS_SURF_SPHERE, &j, why, sizeof why), "%s", why);
   scdt_job_reset(&j);
 
   /* Bad points: a NaN, and points all in one plane. */
@@ -311,7 +311,7 @@ int main(int argc, char **argv) {
   scdt_init(argc, argv);
   const char *args[] = {"--workers", "2", NULL};
   REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
-  sphere = scdt_sample(SC_SURF_SPHERE, 3000, 11);
+  sphere = scdt_sample(SCS_SURF_SPHERE, 3000, 11);
   malformed();
   invalid_requests();
   CHECK_EQ(scdt_stat_wait(d.sock, "jobs_active", 0, T_MS), 0);

@@ -17,9 +17,10 @@
 #include <string.h>
 
 #include "harness.h"
-#include "testsupport.h"
+#include "synth.h"
 
-static const int surfaces[] = {SC_SURF_SPHERE, SC_SURF_TORUS, SC_SURF_GENUS2};
+static const int surfaces[] = {SCS_SURF_SPHERE, SCS_SURF_TORUS,
+                               SCS_SURF_GENUS2};
 static const size_t sizes[] = {2000, 3000, 4000};
 
 typedef struct client_arg {

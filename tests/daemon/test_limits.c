@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "harness.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 120000
 
@@ -22,11 +22,11 @@ static scdt_daemon_t d;
 static double *sphere;   /* 4000 points */
 
 static void run_ok(scdt_conn_t *c, uint32_t id, const char *when) {
-  scdt_run_ok(c, id, SC_SURF_SPHERE, sphere, 4000, T_MS, when);
+  scdt_run_ok(c, id, SCS_SURF_SPHERE, sphere, 4000, T_MS, when);
 }
 
 static void check_serving(const char *when) {
-  scdt_check_serving(d.sock, SC_SURF_SPHERE, sphere, 4000, T_MS, when);
+  scdt_check_serving(d.sock, SCS_SURF_SPHERE, sphere, 4000, T_MS, when);
 }
 
 /* Collects one job that must fail with the code; `other`, when not NULL,
@@ -101,7 +101,7 @@ static void points(void) {
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, SCP_FRAME_MIN, &c) == 0, "connect");
   CHECK_EQ(c->welcome.max_points, 5000);
-  double *many = scdt_sample(SC_SURF_SPHERE, 5001, 8);
+  double *many = scdt_sample(SCS_SURF_SPHERE, 5001, 8);
   /* Announced too many: refused at once. */
   scdt_job_t j;
   scdt_job_init(&j, 1, many, 5001);
@@ -155,7 +155,7 @@ static void budget(void) {
   CHECK(scdt_job_points(c, &a, 4000) == 0 && scdt_job_end(c, &a) == 0,
         "send a");
   CHECK(scdt_collect(c, &pa, 1, T_MS, why, sizeof why) == 0, "%s", why);
-  CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &a, why, sizeof why), "%s", why);
+  CHECK(scdt_mesh_ok(SCS_SURF_SPHERE, &a, why, sizeof why), "%s", why);
   scdt_job_reset(&a);
   scdt_job_reset(&b);
   scdt_job_reset(&u);
@@ -195,7 +195,7 @@ int main(int argc, char **argv) {
                         "--max-points", "5000",   "--memory-budget",
                         BUDGET,         NULL};
   REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
-  sphere = scdt_sample(SC_SURF_SPHERE, 4000, 1);
+  sphere = scdt_sample(SCS_SURF_SPHERE, 4000, 1);
 
   connections();
   check_serving("after the connection limit");

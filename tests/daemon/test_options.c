@@ -13,7 +13,7 @@
 
 #include "harness.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 120000
 #define N 3000
@@ -180,7 +180,7 @@ static void options_refused(void) {
         "empty option list: got frame type 0x%04x", f->type);
   free(f);
   scp_buf_free(&b);
-  scdt_run_ok(c, 17, SC_SURF_SPHERE, sphere, N, T_MS, "after refusals");
+  scdt_run_ok(c, 17, SCS_SURF_SPHERE, sphere, N, T_MS, "after refusals");
   scdt_close(c);
 
   /* Options on a connection that did not agree on them: malformed. */
@@ -198,14 +198,14 @@ static void options_refused(void) {
   printf("options without the feature: fatal %s: %s\n",
          scp_wire_name(old->last_error.code), old->last_error.message);
   scdt_close(old);
-  scdt_check_serving(d.sock, SC_SURF_SPHERE, sphere, N, T_MS,
+  scdt_check_serving(d.sock, SCS_SURF_SPHERE, sphere, N, T_MS,
                      "after a malformed JOB_BEGIN");
 }
 
 int main(int argc, char **argv) {
   scdt_init(argc, argv);
-  sphere = scdt_sample(SC_SURF_SPHERE, N, 3);
-  torus = scdt_sample_random(SC_SURF_TORUS, N, 3);
+  sphere = scdt_sample(SCS_SURF_SPHERE, N, 3);
+  torus = scdt_sample_random(SCS_SURF_TORUS, N, 3);
   REQUIRE(sphere != NULL && torus != NULL, "sample");
   const char *args[] = {"--workers", "2", NULL};
   REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon");

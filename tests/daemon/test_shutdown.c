@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "harness.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 120000
 
@@ -30,8 +30,8 @@ static void running_and_queued(void) {
   const char *args[] = {"--workers", "1", "--grace", "60", NULL};
   REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
   size_t big = 15000;
-  double *xyz = scdt_sample(SC_SURF_SPHERE, big, 1);
-  double *small = scdt_sample(SC_SURF_TORUS, 3000, 2);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, big, 1);
+  double *small = scdt_sample(SCS_SURF_TORUS, 3000, 2);
   scdt_conn_t *a, *b;
   REQUIRE(scdt_open(d.sock, 1u << 20, &a) == 0, "a");
   REQUIRE(scdt_open(d.sock, 1u << 20, &b) == 0, "b");
@@ -57,7 +57,7 @@ static void running_and_queued(void) {
   char why[512] = "";
   CHECK(scdt_collect(a, pa, 2, T_MS, why, sizeof why) == 0, "%s", why);
   CHECK(scdt_collect(b, &pb, 1, T_MS, why, sizeof why) == 0, "%s", why);
-  CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &run, why, sizeof why),
+  CHECK(scdt_mesh_ok(SCS_SURF_SPHERE, &run, why, sizeof why),
         "the running job must finish: %s", why);
   CHECK(queued.error_code == SCP_WIRE_SHUTDOWN,
         "queued job: want SHUTDOWN, got %s", scp_wire_name(queued.error_code));
@@ -95,7 +95,7 @@ static void grace_over(void) {
   const char *args[] = {"--workers", "1", "--grace", "0.2", NULL};
   REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
   size_t big = 60000;
-  double *xyz = scdt_sample_random(SC_SURF_SPHERE, big, 3);
+  double *xyz = scdt_sample_random(SCS_SURF_SPHERE, big, 3);
   scdt_conn_t *a;
   REQUIRE(scdt_open(d.sock, 1u << 20, &a) == 0, "a");
   scdt_job_t run;

@@ -20,7 +20,7 @@
 #include <sys/socket.h>
 
 #include "harness.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 120000
 /* The daemon's caps (daemon/server.c). */
@@ -65,9 +65,9 @@ static uint64_t flood(scdt_conn_t *c) {
 }
 
 static void check_serving(const char *when) {
-  double *xyz = scdt_sample(SC_SURF_TORUS, 3000, 42);
+  double *xyz = scdt_sample(SCS_SURF_TORUS, 3000, 42);
   REQUIRE(xyz != NULL, "%s: sample", when);
-  scdt_check_serving(d.sock, SC_SURF_TORUS, xyz, 3000, T_MS, when);
+  scdt_check_serving(d.sock, SCS_SURF_TORUS, xyz, 3000, T_MS, when);
   free(xyz);
 }
 
@@ -81,7 +81,7 @@ static void check_bounded(const char *when) {
 static void small(void) {
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, SCP_FRAME_MIN, &c) == 0, "connect");
-  double *xyz = scdt_sample(SC_SURF_SPHERE, 4000, 1);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, 4000, 1);
   scdt_job_t j;
   scdt_job_init(&j, 3, xyz, 4000);
   j.flags = SCP_JOB_NORMALS | SCP_JOB_NORMALS_F64;
@@ -113,7 +113,7 @@ static void big(void) {
   REQUIRE(scdt_open(d.sock, 1u << 20, &c) == 0, "connect");
   enum { NJ = 4 };
   size_t n = 40000;
-  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 2);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, n, 2);
   scdt_job_t j[NJ];
   for (int k = 0; k < NJ; k++) {
     scdt_job_init(&j[k], (uint32_t)k + 1, xyz, n);
@@ -137,7 +137,7 @@ static void big(void) {
   char why[512] = "";
   CHECK(scdt_collect(c, pj, NJ, T_MS, why, sizeof why) == 0, "%s", why);
   for (int k = 0; k < NJ; k++) {
-    CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &j[k], why, sizeof why), "%s", why);
+    CHECK(scdt_mesh_ok(SCS_SURF_SPHERE, &j[k], why, sizeof why), "%s", why);
     scdt_job_reset(&j[k]);
   }
   /* And once more, leaving in the middle. */

@@ -18,7 +18,7 @@
 #include <unistd.h>
 
 #include "harness.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 120000
 
@@ -37,7 +37,7 @@ static void check_job(const char *sock, const char *when) {
   CHECK(scdt_job_send(c, &j) == 0, "%s: send", when);
   CHECK(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s: %s", when,
         why);
-  CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &j, why, sizeof why), "%s: %s", when,
+  CHECK(scdt_mesh_ok(SCS_SURF_SPHERE, &j, why, sizeof why), "%s: %s", when,
         why);
   scdt_job_reset(&j);
   scdt_close(c);
@@ -233,7 +233,7 @@ static void socket_activation(void) {
 
 int main(int argc, char **argv) {
   scdt_init(argc, argv);
-  sphere = scdt_sample(SC_SURF_SPHERE, 2000, 5);
+  sphere = scdt_sample(SCS_SURF_SPHERE, 2000, 5);
   stale_and_second();
   not_a_socket_and_foreign();
   modes_and_defaults();

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 
 #include "harness.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 120000
 
@@ -24,14 +24,14 @@ int main(int argc, char **argv) {
   /* Others are served while the silent one waits. */
   scdt_conn_t *c;
   REQUIRE(scdt_open(d.sock, 1u << 20, &c) == 0, "connect");
-  double *xyz = scdt_sample(SC_SURF_SPHERE, 2000, 1);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, 2000, 1);
   scdt_job_t j;
   scdt_job_init(&j, 1, xyz, 2000);
   scdt_job_t *pj = &j;
   char why[512] = "";
   CHECK(scdt_job_send(c, &j) == 0, "send");
   CHECK(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s", why);
-  CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &j, why, sizeof why), "%s", why);
+  CHECK(scdt_mesh_ok(SCS_SURF_SPHERE, &j, why, sizeof why), "%s", why);
   scdt_job_reset(&j);
   scdt_close(c);
 

@@ -7,7 +7,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "testsupport.h"
+#include "synth.h"
 #include "tsassert.h"
 
 #include <stdlib.h>
@@ -18,30 +18,30 @@ enum { N = 1500 };
 /* A guard value after the n points shows a sampler writing past them. */
 static const double guard = -12345.678;
 
-static double *sample(sc_surface_t s, int d, size_t n, uint64_t seed) {
+static double *sample(scs_surface_t s, int d, size_t n, uint64_t seed) {
   double *xyz = malloc((3 * n + 3) * sizeof *xyz);
   if (!xyz)
     abort();
   for (int k = 0; k < 3; k++)
     xyz[3 * n + k] = guard;
-  int rc = sc_sample_surface(s, d, n, seed, xyz);
-  TS_EQ_I64(rc, SC_TS_OK);
+  int rc = scs_sample_surface(s, d, n, seed, xyz);
+  TS_EQ_I64(rc, SCS_OK);
   for (int k = 0; k < 3; k++)
     TS_TRUE(xyz[3 * n + k] == guard, "%s/%s wrote past %zu points",
-            sc_surface_name(s), sc_density_name(d), n);
+            scs_surface_name(s), scs_density_name(d), n);
   return xyz;
 }
 
 static void test_on_surface(void) {
-  for (int s = 0; s < SC_SURF_COUNT; s++)
-    for (int d = 0; d < SC_DENSITY_COUNT; d++) {
-      const sc_surface_info_t *info = sc_surface_info((sc_surface_t)s);
-      double *a = sample((sc_surface_t)s, d, N, 42);
-      double *b = sample((sc_surface_t)s, d, N, 42);
-      double *c = sample((sc_surface_t)s, d, N, 43);
+  for (int s = 0; s < SCS_SURF_COUNT; s++)
+    for (int d = 0; d < SCS_DENSITY_COUNT; d++) {
+      const scs_surface_info_t *info = scs_surface_info((scs_surface_t)s);
+      double *a = sample((scs_surface_t)s, d, N, 42);
+      double *b = sample((scs_surface_t)s, d, N, 42);
+      double *c = sample((scs_surface_t)s, d, N, 43);
       TS_TRUE(memcmp(a, b, 3 * N * sizeof *a) == 0,
               "%s/%s: the same seed gave different points", info->name,
-              sc_density_name(d));
+              scs_density_name(d));
       size_t same = 0;
       for (size_t i = 0; i < N; i++)
         same += memcmp(a + 3 * i, c + 3 * i, 3 * sizeof *a) == 0;
@@ -50,7 +50,7 @@ static void test_on_surface(void) {
       size_t outside = 0;
       for (size_t i = 0; i < N; i++) {
         const double *p = a + 3 * i;
-        double dist = sc_surface_distance((sc_surface_t)s, p);
+        double dist = scs_surface_distance((scs_surface_t)s, p);
         if (!(dist <= worst))
           worst = dist;
         for (int k = 0; k < 3; k++)
@@ -58,7 +58,7 @@ static void test_on_surface(void) {
                        p[k] <= info->bbox_max[k] + 1e-12);
       }
       TS_TRUE(worst <= 1e-9, "%s/%s: a point %.3g from the surface", info->name,
-              sc_density_name(d), worst);
+              scs_density_name(d), worst);
       TS_EQ_U64(outside, 0);
       free(a);
       free(b);
@@ -69,23 +69,23 @@ static void test_on_surface(void) {
 /* The number asked for, at the edges too. */
 static void test_counts(void) {
   static const size_t counts[] = {1, 2, 3, 10, 257};
-  for (int d = 0; d < SC_DENSITY_COUNT; d++)
+  for (int d = 0; d < SCS_DENSITY_COUNT; d++)
     for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++) {
-      double *a = sample(SC_SURF_TORUS, d, counts[i], 7);
+      double *a = sample(SCS_SURF_TORUS, d, counts[i], 7);
       free(a);
     }
-  TS_EQ_I64(sc_sample_surface(SC_SURF_SPHERE, SC_DENSITY_UNIFORM, 0, 1, NULL),
-            SC_TS_OK);
+  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM, 0, 1, NULL),
+            SCS_OK);
   double p[3];
-  TS_EQ_I64(sc_sample_surface(SC_SURF_COUNT, 0, 1, 1, p), SC_TS_EINVAL);
-  TS_EQ_I64(sc_sample_surface((sc_surface_t)-1, 0, 1, 1, p), SC_TS_EINVAL);
-  TS_EQ_I64(sc_sample_surface(SC_SURF_SPHERE, SC_DENSITY_COUNT, 1, 1, p),
-            SC_TS_EINVAL);
-  TS_EQ_I64(sc_sample_surface(SC_SURF_SPHERE, -1, 1, 1, p), SC_TS_EINVAL);
-  TS_EQ_I64(sc_sample_surface(SC_SURF_SPHERE, 0, 1, 1, NULL), SC_TS_EINVAL);
-  TS_EQ_I64(sc_sample_surface(SC_SURF_SPHERE, SC_DENSITY_UNIFORM,
-                              (size_t)600000000, 1, p),
-            SC_TS_EINVAL);
+  TS_EQ_I64(scs_sample_surface(SCS_SURF_COUNT, 0, 1, 1, p), SCS_EINVAL);
+  TS_EQ_I64(scs_sample_surface((scs_surface_t)-1, 0, 1, 1, p), SCS_EINVAL);
+  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_COUNT, 1, 1, p),
+            SCS_EINVAL);
+  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, -1, 1, 1, p), SCS_EINVAL);
+  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, 0, 1, 1, NULL), SCS_EINVAL);
+  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM,
+                               (size_t)600000000, 1, p),
+            SCS_EINVAL);
 }
 
 /*
@@ -98,16 +98,16 @@ static void test_counts(void) {
 static void test_proportions(void) {
   enum { M = 40000 };
   static const double pi = 3.14159265358979323846;
-  for (int d = 0; d < SC_DENSITY_COUNT; d++) {
-    if (d == SC_DENSITY_ADAPTIVE)
+  for (int d = 0; d < SCS_DENSITY_COUNT; d++) {
+    if (d == SCS_DENSITY_ADAPTIVE)
       continue; /* not area-uniform by design */
     struct {
-      sc_surface_t s;
+      scs_surface_t s;
       double expect;
-    } cases[] = {{SC_SURF_TWO_SPHERES, 0.5},
-                 {SC_SURF_NESTED_SPHERES, 0.2},
-                 {SC_SURF_SPHERE, 0.5},
-                 {SC_SURF_TORUS, (1 + 2 * 0.35 / pi) / 2}};
+    } cases[] = {{SCS_SURF_TWO_SPHERES, 0.5},
+                 {SCS_SURF_NESTED_SPHERES, 0.2},
+                 {SCS_SURF_SPHERE, 0.5},
+                 {SCS_SURF_TORUS, (1 + 2 * 0.35 / pi) / 2}};
     for (int c = 0; c < 4; c++) {
       double *a = sample(cases[c].s, d, M, 99);
       size_t hits = 0;
@@ -115,13 +115,13 @@ static void test_proportions(void) {
         const double *p = a + 3 * i;
         double rho2 = p[0] * p[0] + p[1] * p[1];
         switch (cases[c].s) {
-        case SC_SURF_TWO_SPHERES:
+        case SCS_SURF_TWO_SPHERES:
           hits += p[0] < 0;
           break;
-        case SC_SURF_NESTED_SPHERES:
+        case SCS_SURF_NESTED_SPHERES:
           hits += rho2 + p[2] * p[2] < 0.5;
           break;
-        case SC_SURF_SPHERE:
+        case SCS_SURF_SPHERE:
           hits += p[2] > 0;
           break;
         default:
@@ -138,8 +138,8 @@ static void test_proportions(void) {
    * of the ellipsoid's long axis (curvature 11) over twice what an
    * area-uniform sample has there (3.3 times, measured), and fewer at its
    * flat poles (curvature 0.8; 0.8 times, measured). */
-  double *u = sample(SC_SURF_ELLIPSOID, SC_DENSITY_UNIFORM, M, 99);
-  double *a = sample(SC_SURF_ELLIPSOID, SC_DENSITY_ADAPTIVE, M, 99);
+  double *u = sample(SCS_SURF_ELLIPSOID, SCS_DENSITY_UNIFORM, M, 99);
+  double *a = sample(SCS_SURF_ELLIPSOID, SCS_DENSITY_ADAPTIVE, M, 99);
   size_t tips_u = 0, tips_a = 0, flat_u = 0, flat_a = 0;
   for (size_t i = 0; i < M; i++) {
     tips_u += fabs(u[3 * i]) > 0.97;
@@ -154,24 +154,24 @@ static void test_proportions(void) {
 }
 
 static void test_names(void) {
-  for (int s = 0; s < SC_SURF_COUNT; s++) {
-    const char *name = sc_surface_name((sc_surface_t)s);
-    TS_EQ_I64(sc_surface_from_name(name), s);
-    TS_TRUE(strcmp(name, sc_surface_info((sc_surface_t)s)->name) == 0, "%s",
+  for (int s = 0; s < SCS_SURF_COUNT; s++) {
+    const char *name = scs_surface_name((scs_surface_t)s);
+    TS_EQ_I64(scs_surface_from_name(name), s);
+    TS_TRUE(strcmp(name, scs_surface_info((scs_surface_t)s)->name) == 0, "%s",
             name);
   }
-  TS_TRUE(strcmp(sc_surface_name(SC_SURF_COUNT), "?") == 0, "bad name");
-  TS_TRUE(sc_surface_info(SC_SURF_COUNT) == NULL, "info out of range");
-  TS_EQ_I64(sc_surface_from_name("cube"), -1);
-  TS_EQ_I64(sc_surface_from_name(NULL), -1);
-  for (int d = 0; d < SC_DENSITY_COUNT; d++)
-    TS_EQ_I64(sc_density_from_name(sc_density_name(d)), d);
-  TS_TRUE(strcmp(sc_density_name(SC_DENSITY_COUNT), "?") == 0, "bad name");
-  TS_EQ_I64(sc_density_from_name("dense"), -1);
-  TS_EQ_I64(sc_density_from_name(NULL), -1);
-  TS_NEAR(sc_surface_spacing(SC_SURF_SPHERE, 100),
+  TS_TRUE(strcmp(scs_surface_name(SCS_SURF_COUNT), "?") == 0, "bad name");
+  TS_TRUE(scs_surface_info(SCS_SURF_COUNT) == NULL, "info out of range");
+  TS_EQ_I64(scs_surface_from_name("cube"), -1);
+  TS_EQ_I64(scs_surface_from_name(NULL), -1);
+  for (int d = 0; d < SCS_DENSITY_COUNT; d++)
+    TS_EQ_I64(scs_density_from_name(scs_density_name(d)), d);
+  TS_TRUE(strcmp(scs_density_name(SCS_DENSITY_COUNT), "?") == 0, "bad name");
+  TS_EQ_I64(scs_density_from_name("dense"), -1);
+  TS_EQ_I64(scs_density_from_name(NULL), -1);
+  TS_NEAR(scs_surface_spacing(SCS_SURF_SPHERE, 100),
           sqrt(4 * 3.14159265358979323846 / 100), 1e-15);
-  TS_NEAR(sc_surface_spacing(SC_SURF_SPHERE, 0), 0, 0);
+  TS_NEAR(scs_surface_spacing(SCS_SURF_SPHERE, 0), 0, 0);
 }
 
 int main(void) {

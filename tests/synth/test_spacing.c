@@ -1,7 +1,7 @@
 /*
- * How the samples are spaced, against what testsupport.h promises and what
+ * How the samples are spaced, against what synth.h promises and what
  * theory says, measured by each point's nearest-neighbour distance in units
- * of sc_surface_spacing() (sqrt(area / n)):
+ * of scs_surface_spacing() (sqrt(area / n)):
  *
  *  - UNIFORM is well spaced on every surface: no two points closer than
  *    0.63 units, the median 0.76 to 0.80, none above 1.45. (Measured: at
@@ -19,7 +19,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "testsupport.h"
+#include "synth.h"
 #include "tsassert.h"
 
 #include <stdlib.h>
@@ -145,47 +145,47 @@ static stats_t stats_of(double *v, size_t n, double unit) {
   return (stats_t){v[0] / unit, v[n / 2] / unit, v[n - 1] / unit};
 }
 
-static double *sample(sc_surface_t s, int d, size_t n, uint64_t seed) {
+static double *sample(scs_surface_t s, int d, size_t n, uint64_t seed) {
   double *xyz = malloc(3 * n * sizeof *xyz);
   if (!xyz)
     abort();
-  TS_EQ_I64(sc_sample_surface(s, d, n, seed, xyz), SC_TS_OK);
+  TS_EQ_I64(scs_sample_surface(s, d, n, seed, xyz), SCS_OK);
   return xyz;
 }
 
 /* The well-spaced band of UNIFORM, and of ADAPTIVE where it is uniform. */
-static void check_spaced(sc_surface_t s, int d, size_t n, uint64_t seed) {
+static void check_spaced(scs_surface_t s, int d, size_t n, uint64_t seed) {
   double *xyz = sample(s, d, n, seed);
-  double unit = sc_surface_spacing(s, n);
+  double unit = scs_surface_spacing(s, n);
   double *nn = nearest(xyz, n, unit);
   stats_t st = stats_of(nn, n, unit);
   TS_TRUE(st.min >= 0.63 && st.median >= 0.76 && st.median <= 0.80 &&
               st.max <= 1.45,
           "%s/%s n=%zu: nearest neighbours min %.3f median %.3f max %.3f",
-          sc_surface_name(s), sc_density_name(d), n, st.min, st.median, st.max);
+          scs_surface_name(s), scs_density_name(d), n, st.min, st.median, st.max);
   free(nn);
   free(xyz);
 }
 
 static void test_uniform(void) {
-  for (int s = 0; s < SC_SURF_COUNT; s++)
-    check_spaced((sc_surface_t)s, SC_DENSITY_UNIFORM, 4000, 5);
+  for (int s = 0; s < SCS_SURF_COUNT; s++)
+    check_spaced((scs_surface_t)s, SCS_DENSITY_UNIFORM, 4000, 5);
   /* Small and larger samples alike. */
-  check_spaced(SC_SURF_SPHERE, SC_DENSITY_UNIFORM, 300, 6);
-  check_spaced(SC_SURF_TORUS, SC_DENSITY_UNIFORM, 30000, 7);
+  check_spaced(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM, 300, 6);
+  check_spaced(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, 30000, 7);
   /* Constant curvature: ADAPTIVE has nothing to adapt to. */
-  check_spaced(SC_SURF_SPHERE, SC_DENSITY_ADAPTIVE, 4000, 5);
-  check_spaced(SC_SURF_TWO_SPHERES, SC_DENSITY_ADAPTIVE, 4000, 5);
-  check_spaced(SC_SURF_TORUS, SC_DENSITY_ADAPTIVE, 4000, 5);
+  check_spaced(SCS_SURF_SPHERE, SCS_DENSITY_ADAPTIVE, 4000, 5);
+  check_spaced(SCS_SURF_TWO_SPHERES, SCS_DENSITY_ADAPTIVE, 4000, 5);
+  check_spaced(SCS_SURF_TORUS, SCS_DENSITY_ADAPTIVE, 4000, 5);
 }
 
 /* A Poisson sample of density n / A: P(nn > r) = exp(-pi r^2 n / A). */
 static void test_random(void) {
   const double median = 0.46971863934982566; /* sqrt(ln 2 / pi) */
-  for (int s = 0; s < SC_SURF_COUNT; s++) {
+  for (int s = 0; s < SCS_SURF_COUNT; s++) {
     size_t n = 20000;
-    double *xyz = sample((sc_surface_t)s, SC_DENSITY_UNIFORM_RANDOM, n, 8);
-    double unit = sc_surface_spacing((sc_surface_t)s, n);
+    double *xyz = sample((scs_surface_t)s, SCS_DENSITY_UNIFORM_RANDOM, n, 8);
+    double unit = scs_surface_spacing((scs_surface_t)s, n);
     double *nn = nearest(xyz, n, unit);
     stats_t st = stats_of(nn, n, unit);
     TS_NEAR(st.median, median, 0.012);
@@ -199,8 +199,8 @@ static void test_random(void) {
  * the inner sphere, at half the spacing. */
 static void test_adaptive(void) {
   size_t n = 8000;
-  double *xyz = sample(SC_SURF_NESTED_SPHERES, SC_DENSITY_ADAPTIVE, n, 9);
-  double *nn = nearest(xyz, n, sc_surface_spacing(SC_SURF_NESTED_SPHERES, n));
+  double *xyz = sample(SCS_SURF_NESTED_SPHERES, SCS_DENSITY_ADAPTIVE, n, 9);
+  double *nn = nearest(xyz, n, scs_surface_spacing(SCS_SURF_NESTED_SPHERES, n));
   double *in = malloc(n * sizeof *in), *out = malloc(n * sizeof *out);
   if (!in || !out)
     abort();
@@ -227,8 +227,8 @@ static void test_adaptive(void) {
   /* The ellipsoid: closer points at the curved tips of its long axis than
    * at its flat poles, by up to sqrt(6) (measured 2.12). */
   n = 6000;
-  xyz = sample(SC_SURF_ELLIPSOID, SC_DENSITY_ADAPTIVE, n, 5);
-  nn = nearest(xyz, n, sc_surface_spacing(SC_SURF_ELLIPSOID, n));
+  xyz = sample(SCS_SURF_ELLIPSOID, SCS_DENSITY_ADAPTIVE, n, 5);
+  nn = nearest(xyz, n, scs_surface_spacing(SCS_SURF_ELLIPSOID, n));
   double *tip = malloc(n * sizeof *tip), *flat = malloc(n * sizeof *flat);
   if (!tip || !flat)
     abort();
@@ -253,7 +253,7 @@ static void test_adaptive(void) {
 /* The grid search against brute force, on a sample with clumps. */
 static void test_nearest(void) {
   size_t n = 700;
-  double *xyz = sample(SC_SURF_GENUS2, SC_DENSITY_UNIFORM_RANDOM, n, 10);
+  double *xyz = sample(SCS_SURF_GENUS2, SCS_DENSITY_UNIFORM_RANDOM, n, 10);
   /* A far outlier, so that rings must grow well past the first. */
   xyz[0] = 5;
   double *nn = nearest(xyz, n, 0.05);

@@ -6,7 +6,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "testsupport.h"
+#include "synth.h"
 #include "tsassert.h"
 
 #include <stdlib.h>
@@ -23,9 +23,9 @@ static const uint32_t oct_tri[] = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4,
                                    2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
 
 static void check(size_t n, const double *xyz, const uint32_t *tri, size_t ntri,
-                  const unsigned char *ignore, sc_meshcheck_t *c) {
-  int rc = sc_meshcheck(n, xyz, tri, ntri, ignore, c);
-  TS_EQ_I64(rc, SC_TS_OK);
+                  const unsigned char *ignore, scs_meshcheck_t *c) {
+  int rc = scs_meshcheck(n, xyz, tri, ntri, ignore, c);
+  TS_EQ_I64(rc, SCS_OK);
 }
 
 /* Copies of the vertex and triangle arrays, shifted and with room. */
@@ -50,22 +50,22 @@ static void add(mesh_t *m, const double *xyz, size_t n, const uint32_t *tri,
   m->nt += nt;
 }
 
-static void expect_ok(const sc_meshcheck_t *c, sc_surface_t s, unsigned flags) {
+static void expect_ok(const scs_meshcheck_t *c, scs_surface_t s, unsigned flags) {
   char why[256];
-  int ok = sc_meshcheck_expect(c, s, flags, why, sizeof why);
-  TS_TRUE(ok, "expected a good %s, got: %s", sc_surface_name(s), why);
+  int ok = scs_meshcheck_expect(c, s, flags, why, sizeof why);
+  TS_TRUE(ok, "expected a good %s, got: %s", scs_surface_name(s), why);
 }
 
-static void expect_bad(const sc_meshcheck_t *c, sc_surface_t s, unsigned flags,
+static void expect_bad(const scs_meshcheck_t *c, scs_surface_t s, unsigned flags,
                        const char *reason) {
   char why[256];
-  int ok = sc_meshcheck_expect(c, s, flags, why, sizeof why);
+  int ok = scs_meshcheck_expect(c, s, flags, why, sizeof why);
   TS_TRUE(!ok && strstr(why, reason) != NULL,
           "expected a failure with \"%s\", got %d \"%s\"", reason, ok, why);
 }
 
 static void test_tetrahedron(void) {
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(4, tet_xyz, tet_tri, 4, NULL, &c);
   TS_EQ_U64(c.points, 4);
   TS_EQ_U64(c.triangles, 4);
@@ -88,29 +88,29 @@ static void test_tetrahedron(void) {
   TS_NEAR(c.comp[0].volume, 1.0 / 6, 1e-15);
   /* Three right triangles of area 1/2 and an equilateral one. */
   TS_NEAR(c.area, 1.5 + 0.8660254037844386, 1e-15);
-  expect_ok(&c, SC_SURF_SPHERE, SC_EXPECT_ALL_USED | SC_EXPECT_OUTWARD);
+  expect_ok(&c, SCS_SURF_SPHERE, SCS_EXPECT_ALL_USED | SCS_EXPECT_OUTWARD);
   char line[512];
-  sc_meshcheck_summary(&c, line, sizeof line);
+  scs_meshcheck_summary(&c, line, sizeof line);
   TS_TRUE(strstr(line, "faces=4 V=4 E=6 comps=1 closed=1/1 genus=[0] chi=2") !=
               NULL,
           "summary: %s", line);
-  sc_meshcheck_free(&c);
-  sc_meshcheck_free(&c);
-  sc_meshcheck_free(NULL);
+  scs_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
+  scs_meshcheck_free(NULL);
 }
 
 /* Every face turned over: still consistent, but inside out. */
 static void test_inverted(void) {
   mesh_t m = {.n = 0};
   add(&m, tet_xyz, 4, tet_tri, 4, 0, 1);
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
   TS_TRUE(c.closed && c.oriented, "closed %d oriented %d", c.closed,
           c.oriented);
   TS_NEAR(c.comp[0].volume, -1.0 / 6, 1e-15);
-  expect_ok(&c, SC_SURF_SPHERE, 0);
-  expect_bad(&c, SC_SURF_SPHERE, SC_EXPECT_OUTWARD, "signed volume");
-  sc_meshcheck_free(&c);
+  expect_ok(&c, SCS_SURF_SPHERE, 0);
+  expect_bad(&c, SCS_SURF_SPHERE, SCS_EXPECT_OUTWARD, "signed volume");
+  scs_meshcheck_free(&c);
 }
 
 /* One face turned over: each of its three edges is then used twice in
@@ -120,19 +120,19 @@ static void test_inconsistent(void) {
   memcpy(tri, tet_tri, sizeof tri);
   tri[10] = 3;
   tri[11] = 2;
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(4, tet_xyz, tri, 4, NULL, &c);
   TS_EQ_U64(c.orientation_errors, 3);
   TS_TRUE(c.manifold && c.closed && !c.oriented, "%d %d %d", c.manifold,
           c.closed, c.oriented);
-  expect_bad(&c, SC_SURF_SPHERE, 0, "inconsistent orientation");
-  sc_meshcheck_free(&c);
+  expect_bad(&c, SCS_SURF_SPHERE, 0, "inconsistent orientation");
+  scs_meshcheck_free(&c);
 }
 
 /* A face missing: three boundary edges in one loop; still a disc, so
  * genus 0. */
 static void test_boundary(void) {
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(4, tet_xyz, tet_tri, 3, NULL, &c);
   TS_EQ_U64(c.boundary_edges, 3);
   TS_EQ_U64(c.boundary_loops, 1);
@@ -145,8 +145,8 @@ static void test_boundary(void) {
   /* Open components add nothing to the totals. */
   TS_EQ_I64(c.genus_total, 0);
   TS_NEAR(c.volume, 0, 0);
-  expect_bad(&c, SC_SURF_SPHERE, 0, "boundary edges");
-  sc_meshcheck_free(&c);
+  expect_bad(&c, SCS_SURF_SPHERE, 0, "boundary edges");
+  scs_meshcheck_free(&c);
 
   /* An open band of four quads (an annulus): two loops, genus 0. */
   double xyz[8 * 3];
@@ -169,14 +169,14 @@ static void test_boundary(void) {
   TS_EQ_I64(c.euler, 0);
   TS_EQ_I64(c.comp[0].genus, 0);
   TS_TRUE(c.oriented && c.manifold, "%d %d", c.oriented, c.manifold);
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
 }
 
 /* Three triangles on one edge. */
 static void test_nonmanifold_edge(void) {
   static const double xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1};
   static const uint32_t tri[] = {0, 1, 2, 1, 0, 3, 0, 1, 4};
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(5, xyz, tri, 3, NULL, &c);
   TS_EQ_U64(c.nonmanifold_edges, 1);
   TS_EQ_U64(c.edges, 7);
@@ -184,8 +184,8 @@ static void test_nonmanifold_edge(void) {
   /* 0 -> 1 is used by the first and the third. */
   TS_EQ_U64(c.orientation_errors, 1);
   TS_TRUE(!c.manifold && !c.closed, "%d %d", c.manifold, c.closed);
-  expect_bad(&c, SC_SURF_SPHERE, 0, "non-manifold edges");
-  sc_meshcheck_free(&c);
+  expect_bad(&c, SCS_SURF_SPHERE, 0, "non-manifold edges");
+  scs_meshcheck_free(&c);
 }
 
 /* Two tetrahedra sharing only a vertex: two closed components, pinched
@@ -198,7 +198,7 @@ static void test_pinched(void) {
   for (size_t i = 12; i < 24; i++)
     if (m.tri[i] == 5)
       m.tri[i] = 0;
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
   TS_EQ_U64(c.nonmanifold_vertices, 1);
   TS_EQ_U64(c.nonmanifold_edges, 0);
@@ -213,8 +213,8 @@ static void test_pinched(void) {
   TS_EQ_I64(c.comp[1].genus, 0);
   TS_TRUE(!c.manifold && !c.closed && c.oriented, "%d %d %d", c.manifold,
           c.closed, c.oriented);
-  expect_bad(&c, SC_SURF_TWO_SPHERES, 0, "non-manifold vertices");
-  sc_meshcheck_free(&c);
+  expect_bad(&c, SCS_SURF_TWO_SPHERES, 0, "non-manifold vertices");
+  scs_meshcheck_free(&c);
 
   /* Two triangles touching at a vertex: two boundary loops, kept apart at
    * the shared vertex. */
@@ -224,7 +224,7 @@ static void test_pinched(void) {
   TS_EQ_U64(c.nonmanifold_vertices, 1);
   TS_EQ_U64(c.boundary_loops, 2);
   TS_EQ_U64(c.components, 2);
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
 }
 
 /* A torus as a 6 x 4 grid of quads: genus 1. */
@@ -257,7 +257,7 @@ static void torus(mesh_t *m) {
 static void test_genus(void) {
   mesh_t m;
   torus(&m);
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
   TS_EQ_U64(c.faces, 48);
   TS_EQ_U64(c.edges, 72);
@@ -265,21 +265,21 @@ static void test_genus(void) {
   TS_EQ_I64(c.genus_total, 1);
   TS_TRUE(c.closed && c.oriented, "%d %d", c.closed, c.oriented);
   TS_LT(0, c.volume);
-  expect_ok(&c, SC_SURF_TORUS, SC_EXPECT_ALL_USED | SC_EXPECT_OUTWARD);
-  expect_bad(&c, SC_SURF_SPHERE, 0, "genus 1 where 0 was expected");
-  sc_meshcheck_free(&c);
+  expect_ok(&c, SCS_SURF_TORUS, SCS_EXPECT_ALL_USED | SCS_EXPECT_OUTWARD);
+  expect_bad(&c, SCS_SURF_SPHERE, 0, "genus 1 where 0 was expected");
+  scs_meshcheck_free(&c);
 
   check(4, tet_xyz, tet_tri, 4, NULL, &c);
-  expect_bad(&c, SC_SURF_TORUS, 0, "genus 0 where 1 was expected");
-  expect_bad(&c, SC_SURF_GENUS2, 0, "genus 0 where 2 was expected");
-  sc_meshcheck_free(&c);
+  expect_bad(&c, SCS_SURF_TORUS, 0, "genus 0 where 1 was expected");
+  expect_bad(&c, SCS_SURF_GENUS2, 0, "genus 0 where 2 was expected");
+  scs_meshcheck_free(&c);
 }
 
 static void test_components(void) {
   mesh_t m = {.n = 0};
   add(&m, oct_xyz, 6, oct_tri, 8, -1.6, 0);
   add(&m, oct_xyz, 6, oct_tri, 8, 1.6, 0);
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
   TS_EQ_U64(c.components, 2);
   TS_EQ_U64(c.closed_components, 2);
@@ -290,9 +290,9 @@ static void test_components(void) {
   /* Eight equilateral faces of side sqrt(2); volume 4/3 each. */
   TS_NEAR(c.area, 2 * 4 * 1.7320508075688772, 1e-13);
   TS_NEAR(c.volume, 8.0 / 3, 1e-14);
-  expect_ok(&c, SC_SURF_TWO_SPHERES, SC_EXPECT_ALL_USED | SC_EXPECT_OUTWARD);
-  expect_bad(&c, SC_SURF_SPHERE, 0, "2 components, expected 1");
-  sc_meshcheck_free(&c);
+  expect_ok(&c, SCS_SURF_TWO_SPHERES, SCS_EXPECT_ALL_USED | SCS_EXPECT_OUTWARD);
+  expect_bad(&c, SCS_SURF_SPHERE, 0, "2 components, expected 1");
+  scs_meshcheck_free(&c);
 
   /* Nested: a small octahedron inside, facing away from its own centre,
    * so both volumes are positive. */
@@ -304,8 +304,8 @@ static void test_components(void) {
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
   TS_EQ_U64(c.components, 2);
   TS_NEAR(c.comp[1].volume, 4.0 / 3 / 8, 1e-15);
-  expect_ok(&c, SC_SURF_NESTED_SPHERES, SC_EXPECT_OUTWARD);
-  sc_meshcheck_free(&c);
+  expect_ok(&c, SCS_SURF_NESTED_SPHERES, SCS_EXPECT_OUTWARD);
+  scs_meshcheck_free(&c);
 }
 
 /* Points left out of the mesh count unless the caller ignores them. */
@@ -313,25 +313,25 @@ static void test_unused(void) {
   double xyz[8 * 3];
   memcpy(xyz, oct_xyz, sizeof oct_xyz);
   memcpy(xyz + 18, oct_xyz, 6 * sizeof *xyz);
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(8, xyz, oct_tri, 8, NULL, &c);
   TS_EQ_U64(c.samples_unused, 2);
   TS_EQ_U64(c.vertices_used, 6);
-  expect_ok(&c, SC_SURF_SPHERE, 0);
-  expect_bad(&c, SC_SURF_SPHERE, SC_EXPECT_ALL_USED, "2 samples unused");
-  sc_meshcheck_free(&c);
+  expect_ok(&c, SCS_SURF_SPHERE, 0);
+  expect_bad(&c, SCS_SURF_SPHERE, SCS_EXPECT_ALL_USED, "2 samples unused");
+  scs_meshcheck_free(&c);
   unsigned char ignore[8] = {0, 0, 0, 0, 0, 0, 1, 0};
   check(8, xyz, oct_tri, 8, ignore, &c);
   TS_EQ_U64(c.samples_unused, 1);
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
   ignore[7] = 1;
   /* Ignoring a vertex that is used changes nothing. */
   ignore[0] = 1;
   check(8, xyz, oct_tri, 8, ignore, &c);
   TS_EQ_U64(c.samples_unused, 0);
   TS_EQ_U64(c.vertices_used, 6);
-  expect_ok(&c, SC_SURF_SPHERE, SC_EXPECT_ALL_USED);
-  sc_meshcheck_free(&c);
+  expect_ok(&c, SCS_SURF_SPHERE, SCS_EXPECT_ALL_USED);
+  scs_meshcheck_free(&c);
 }
 
 /* Triangles that are left out of every measurement, and counted. */
@@ -340,7 +340,7 @@ static void test_left_out(void) {
   memcpy(tri, tet_tri, sizeof tet_tri);
   uint32_t extra[] = {0, 1, 4, 2, 2, 3, 1, 2, 3, 3, 2, 1, 0, 0, 0, 9, 9, 9};
   memcpy(tri + 12, extra, sizeof extra);
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   check(4, tet_xyz, tri, 10, NULL, &c);
   TS_EQ_U64(c.triangles, 10);
   TS_EQ_U64(c.out_of_range, 2);
@@ -350,54 +350,54 @@ static void test_left_out(void) {
   TS_EQ_U64(c.edges, 6);
   TS_TRUE(!c.manifold && c.oriented, "%d %d", c.manifold, c.oriented);
   TS_NEAR(c.volume, 1.0 / 6, 1e-15);
-  expect_bad(&c, SC_SURF_SPHERE, 0, "2 triangles with an index out of range");
-  sc_meshcheck_free(&c);
+  expect_bad(&c, SCS_SURF_SPHERE, 0, "2 triangles with an index out of range");
+  scs_meshcheck_free(&c);
   /* With only the duplicates left in, they are what fails. */
   memcpy(tri + 12, extra + 6, 6 * sizeof *tri);
   check(4, tet_xyz, tri, 6, NULL, &c);
   TS_EQ_U64(c.duplicates, 2);
-  expect_bad(&c, SC_SURF_SPHERE, 0, "2 duplicate triangles");
-  sc_meshcheck_free(&c);
+  expect_bad(&c, SCS_SURF_SPHERE, 0, "2 duplicate triangles");
+  scs_meshcheck_free(&c);
   /* A duplicate keeps its first copy, whichever way that one faces. */
   uint32_t first_flipped[15] = {0, 1, 2};
   memcpy(first_flipped + 3, tet_tri, sizeof tet_tri);
   check(4, tet_xyz, first_flipped, 5, NULL, &c);
   TS_EQ_U64(c.duplicates, 1);
   TS_EQ_U64(c.orientation_errors, 3);
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
 }
 
 static void test_arguments(void) {
-  sc_meshcheck_t c;
+  scs_meshcheck_t c;
   memset(&c, 0xff, sizeof c);
-  TS_EQ_I64(sc_meshcheck(4, tet_xyz, NULL, 4, NULL, &c), SC_TS_EINVAL);
+  TS_EQ_I64(scs_meshcheck(4, tet_xyz, NULL, 4, NULL, &c), SCS_EINVAL);
   TS_EQ_U64(c.faces, 0);
   TS_TRUE(c.comp == NULL, "comp not reset");
-  TS_EQ_I64(sc_meshcheck(4, tet_xyz, tet_tri, 4, NULL, NULL), SC_TS_EINVAL);
-  TS_EQ_I64(sc_meshcheck((size_t)1 << 32, NULL, tet_tri, 4, NULL, &c),
-            SC_TS_EINVAL);
+  TS_EQ_I64(scs_meshcheck(4, tet_xyz, tet_tri, 4, NULL, NULL), SCS_EINVAL);
+  TS_EQ_I64(scs_meshcheck((size_t)1 << 32, NULL, tet_tri, 4, NULL, &c),
+            SCS_EINVAL);
   /* Nothing at all is a valid, empty measurement. */
   check(0, NULL, NULL, 0, NULL, &c);
   TS_EQ_U64(c.components, 0);
   TS_TRUE(c.closed && c.manifold, "empty mesh flags");
-  expect_bad(&c, SC_SURF_SPHERE, 0, "0 components");
-  sc_meshcheck_free(&c);
+  expect_bad(&c, SCS_SURF_SPHERE, 0, "0 components");
+  scs_meshcheck_free(&c);
   /* Without coordinates, topology only. */
   check(4, NULL, tet_tri, 4, NULL, &c);
   TS_EQ_I64(c.genus_total, 0);
   TS_NEAR(c.area, 0, 0);
   TS_NEAR(c.volume, 0, 0);
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
   char why[8];
-  TS_EQ_I64(sc_meshcheck_expect(NULL, SC_SURF_SPHERE, 0, why, sizeof why), 0);
-  TS_EQ_I64(sc_meshcheck_expect(&c, SC_SURF_COUNT, 0, NULL, 0), 0);
+  TS_EQ_I64(scs_meshcheck_expect(NULL, SCS_SURF_SPHERE, 0, why, sizeof why), 0);
+  TS_EQ_I64(scs_meshcheck_expect(&c, SCS_SURF_COUNT, 0, NULL, 0), 0);
 }
 
 static void test_distance(void) {
-  sc_distcheck_t d;
+  scs_distcheck_t d;
   TS_EQ_I64(
-      sc_mesh_distance_check(SC_SURF_SPHERE, 6, oct_xyz, oct_tri, 8, 1e-12, &d),
-      SC_TS_OK);
+      scs_mesh_distance_check(SCS_SURF_SPHERE, 6, oct_xyz, oct_tri, 8, 1e-12, &d),
+      SCS_OK);
   TS_EQ_U64(d.vertices, 6);
   TS_EQ_U64(d.beyond, 0);
   TS_NEAR(d.max_distance, 0, 1e-15);
@@ -406,13 +406,13 @@ static void test_distance(void) {
   xyz[3 * 4 + 2] = 1.25;
   xyz[3 * 5 + 2] = -0.9;
   TS_EQ_I64(
-      sc_mesh_distance_check(SC_SURF_SPHERE, 6, xyz, oct_tri, 8, 0.15, &d),
-      SC_TS_OK);
+      scs_mesh_distance_check(SCS_SURF_SPHERE, 6, xyz, oct_tri, 8, 0.15, &d),
+      SCS_OK);
   TS_EQ_U64(d.beyond, 1);
   TS_EQ_U64(d.worst, 4);
   TS_NEAR(d.max_distance, 0.25, 1e-15);
-  TS_EQ_I64(sc_mesh_distance_check(SC_SURF_COUNT, 6, xyz, oct_tri, 8, 0.1, &d),
-            SC_TS_EINVAL);
+  TS_EQ_I64(scs_mesh_distance_check(SCS_SURF_COUNT, 6, xyz, oct_tri, 8, 0.1, &d),
+            SCS_EINVAL);
 }
 
 int main(void) {
