@@ -6,9 +6,11 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include "sct_assert.h"
 #include "synth.h"
-#include "tsassert.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -25,7 +27,7 @@ static const uint32_t oct_tri[] = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4,
 static void check(size_t n, const double *xyz, const uint32_t *tri, size_t ntri,
                   const unsigned char *ignore, scs_meshcheck_t *c) {
   int rc = scs_meshcheck(n, xyz, tri, ntri, ignore, c);
-  TS_EQ_I64(rc, SCS_OK);
+  EXPECT_EQ(rc, SCS_OK);
 }
 
 /* Copies of the vertex and triangle arrays, shifted and with room. */
@@ -53,47 +55,48 @@ static void add(mesh_t *m, const double *xyz, size_t n, const uint32_t *tri,
 static void expect_ok(const scs_meshcheck_t *c, scs_surface_t s, unsigned flags) {
   char why[256];
   int ok = scs_meshcheck_expect(c, s, flags, why, sizeof why);
-  TS_TRUE(ok, "expected a good %s, got: %s", scs_surface_name(s), why);
+  EXPECT_MSG(ok, "expected a good %s, got: %s", scs_surface_name(s), why);
 }
 
 static void expect_bad(const scs_meshcheck_t *c, scs_surface_t s, unsigned flags,
                        const char *reason) {
   char why[256];
   int ok = scs_meshcheck_expect(c, s, flags, why, sizeof why);
-  TS_TRUE(!ok && strstr(why, reason) != NULL,
-          "expected a failure with \"%s\", got %d \"%s\"", reason, ok, why);
+  EXPECT_MSG(!ok && strstr(why, reason) != NULL,
+             "expected a failure with \"%s\", got %d \"%s\"", reason, ok, why);
 }
 
 static void test_tetrahedron(void) {
   scs_meshcheck_t c;
   check(4, tet_xyz, tet_tri, 4, NULL, &c);
-  TS_EQ_U64(c.points, 4);
-  TS_EQ_U64(c.triangles, 4);
-  TS_EQ_U64(c.faces, 4);
-  TS_EQ_U64(c.edges, 6);
-  TS_EQ_U64(c.vertices_used, 4);
-  TS_EQ_I64(c.euler, 2);
-  TS_EQ_U64(c.components, 1);
-  TS_EQ_U64(c.closed_components, 1);
-  TS_EQ_I64(c.genus_total, 0);
-  TS_EQ_U64(c.boundary_edges + c.nonmanifold_edges + c.nonmanifold_vertices +
+  EXPECT_EQ(c.points, 4);
+  EXPECT_EQ(c.triangles, 4);
+  EXPECT_EQ(c.faces, 4);
+  EXPECT_EQ(c.edges, 6);
+  EXPECT_EQ(c.vertices_used, 4);
+  EXPECT_EQ(c.euler, 2);
+  EXPECT_EQ(c.components, 1);
+  EXPECT_EQ(c.closed_components, 1);
+  EXPECT_EQ(c.genus_total, 0);
+  EXPECT_EQ(c.boundary_edges + c.nonmanifold_edges + c.nonmanifold_vertices +
                 c.orientation_errors + c.samples_unused,
             0);
-  TS_TRUE(c.manifold && c.closed && c.oriented, "flags %d %d %d", c.manifold,
-          c.closed, c.oriented);
-  TS_EQ_U64(c.component_count, 1);
-  TS_EQ_U64(c.comp[0].vertices, 4);
-  TS_EQ_I64(c.comp[0].genus, 0);
-  TS_NEAR(c.volume, 1.0 / 6, 1e-15);
-  TS_NEAR(c.comp[0].volume, 1.0 / 6, 1e-15);
+  EXPECT_MSG(c.manifold && c.closed && c.oriented, "flags %d %d %d", c.manifold,
+             c.closed, c.oriented);
+  EXPECT_EQ(c.component_count, 1);
+  EXPECT_EQ(c.comp[0].vertices, 4);
+  EXPECT_EQ(c.comp[0].genus, 0);
+  EXPECT_NEAR(c.volume, 1.0 / 6, 1e-15);
+  EXPECT_NEAR(c.comp[0].volume, 1.0 / 6, 1e-15);
   /* Three right triangles of area 1/2 and an equilateral one. */
-  TS_NEAR(c.area, 1.5 + 0.8660254037844386, 1e-15);
+  EXPECT_NEAR(c.area, 1.5 + 0.8660254037844386, 1e-15);
   expect_ok(&c, SCS_SURF_SPHERE, SCS_EXPECT_ALL_USED | SCS_EXPECT_OUTWARD);
   char line[512];
   scs_meshcheck_summary(&c, line, sizeof line);
-  TS_TRUE(strstr(line, "faces=4 V=4 E=6 comps=1 closed=1/1 genus=[0] chi=2") !=
-              NULL,
-          "summary: %s", line);
+  EXPECT_MSG(
+      strstr(line, "faces=4 V=4 E=6 comps=1 closed=1/1 genus=[0] chi=2") !=
+          NULL,
+      "summary: %s", line);
   scs_meshcheck_free(&c);
   scs_meshcheck_free(&c);
   scs_meshcheck_free(NULL);
@@ -105,9 +108,9 @@ static void test_inverted(void) {
   add(&m, tet_xyz, 4, tet_tri, 4, 0, 1);
   scs_meshcheck_t c;
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
-  TS_TRUE(c.closed && c.oriented, "closed %d oriented %d", c.closed,
-          c.oriented);
-  TS_NEAR(c.comp[0].volume, -1.0 / 6, 1e-15);
+  EXPECT_MSG(c.closed && c.oriented, "closed %d oriented %d", c.closed,
+             c.oriented);
+  EXPECT_NEAR(c.comp[0].volume, -1.0 / 6, 1e-15);
   expect_ok(&c, SCS_SURF_SPHERE, 0);
   expect_bad(&c, SCS_SURF_SPHERE, SCS_EXPECT_OUTWARD, "signed volume");
   scs_meshcheck_free(&c);
@@ -122,9 +125,9 @@ static void test_inconsistent(void) {
   tri[11] = 2;
   scs_meshcheck_t c;
   check(4, tet_xyz, tri, 4, NULL, &c);
-  TS_EQ_U64(c.orientation_errors, 3);
-  TS_TRUE(c.manifold && c.closed && !c.oriented, "%d %d %d", c.manifold,
-          c.closed, c.oriented);
+  EXPECT_EQ(c.orientation_errors, 3);
+  EXPECT_MSG(c.manifold && c.closed && !c.oriented, "%d %d %d", c.manifold,
+             c.closed, c.oriented);
   expect_bad(&c, SCS_SURF_SPHERE, 0, "inconsistent orientation");
   scs_meshcheck_free(&c);
 }
@@ -134,17 +137,17 @@ static void test_inconsistent(void) {
 static void test_boundary(void) {
   scs_meshcheck_t c;
   check(4, tet_xyz, tet_tri, 3, NULL, &c);
-  TS_EQ_U64(c.boundary_edges, 3);
-  TS_EQ_U64(c.boundary_loops, 1);
-  TS_EQ_U64(c.comp[0].boundary_loops, 1);
-  TS_EQ_I64(c.comp[0].euler, 1);
-  TS_EQ_I64(c.comp[0].genus, 0);
-  TS_EQ_U64(c.closed_components, 0);
-  TS_TRUE(c.manifold && !c.closed && c.oriented, "%d %d %d", c.manifold,
-          c.closed, c.oriented);
+  EXPECT_EQ(c.boundary_edges, 3);
+  EXPECT_EQ(c.boundary_loops, 1);
+  EXPECT_EQ(c.comp[0].boundary_loops, 1);
+  EXPECT_EQ(c.comp[0].euler, 1);
+  EXPECT_EQ(c.comp[0].genus, 0);
+  EXPECT_EQ(c.closed_components, 0);
+  EXPECT_MSG(c.manifold && !c.closed && c.oriented, "%d %d %d", c.manifold,
+             c.closed, c.oriented);
   /* Open components add nothing to the totals. */
-  TS_EQ_I64(c.genus_total, 0);
-  TS_NEAR(c.volume, 0, 0);
+  EXPECT_EQ(c.genus_total, 0);
+  EXPECT_NEAR(c.volume, 0, 0);
   expect_bad(&c, SCS_SURF_SPHERE, 0, "boundary edges");
   scs_meshcheck_free(&c);
 
@@ -164,11 +167,11 @@ static void test_boundary(void) {
     memcpy(tri + 6 * i, q, sizeof q);
   }
   check(8, xyz, tri, 8, NULL, &c);
-  TS_EQ_U64(c.boundary_edges, 8);
-  TS_EQ_U64(c.boundary_loops, 2);
-  TS_EQ_I64(c.euler, 0);
-  TS_EQ_I64(c.comp[0].genus, 0);
-  TS_TRUE(c.oriented && c.manifold, "%d %d", c.oriented, c.manifold);
+  EXPECT_EQ(c.boundary_edges, 8);
+  EXPECT_EQ(c.boundary_loops, 2);
+  EXPECT_EQ(c.euler, 0);
+  EXPECT_EQ(c.comp[0].genus, 0);
+  EXPECT_MSG(c.oriented && c.manifold, "%d %d", c.oriented, c.manifold);
   scs_meshcheck_free(&c);
 }
 
@@ -178,12 +181,12 @@ static void test_nonmanifold_edge(void) {
   static const uint32_t tri[] = {0, 1, 2, 1, 0, 3, 0, 1, 4};
   scs_meshcheck_t c;
   check(5, xyz, tri, 3, NULL, &c);
-  TS_EQ_U64(c.nonmanifold_edges, 1);
-  TS_EQ_U64(c.edges, 7);
-  TS_EQ_U64(c.components, 1);
+  EXPECT_EQ(c.nonmanifold_edges, 1);
+  EXPECT_EQ(c.edges, 7);
+  EXPECT_EQ(c.components, 1);
   /* 0 -> 1 is used by the first and the third. */
-  TS_EQ_U64(c.orientation_errors, 1);
-  TS_TRUE(!c.manifold && !c.closed, "%d %d", c.manifold, c.closed);
+  EXPECT_EQ(c.orientation_errors, 1);
+  EXPECT_MSG(!c.manifold && !c.closed, "%d %d", c.manifold, c.closed);
   expect_bad(&c, SCS_SURF_SPHERE, 0, "non-manifold edges");
   scs_meshcheck_free(&c);
 }
@@ -200,19 +203,19 @@ static void test_pinched(void) {
       m.tri[i] = 0;
   scs_meshcheck_t c;
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
-  TS_EQ_U64(c.nonmanifold_vertices, 1);
-  TS_EQ_U64(c.nonmanifold_edges, 0);
-  TS_EQ_U64(c.components, 2);
-  TS_EQ_U64(c.closed_components, 2);
-  TS_EQ_U64(c.vertices_used, 7);
-  TS_EQ_U64(c.samples_unused, 1);
-  TS_EQ_I64(c.euler, 7 - 12 + 8);
-  TS_EQ_U64(c.comp[0].vertices, 4);
-  TS_EQ_U64(c.comp[1].vertices, 4);
-  TS_EQ_I64(c.comp[0].genus, 0);
-  TS_EQ_I64(c.comp[1].genus, 0);
-  TS_TRUE(!c.manifold && !c.closed && c.oriented, "%d %d %d", c.manifold,
-          c.closed, c.oriented);
+  EXPECT_EQ(c.nonmanifold_vertices, 1);
+  EXPECT_EQ(c.nonmanifold_edges, 0);
+  EXPECT_EQ(c.components, 2);
+  EXPECT_EQ(c.closed_components, 2);
+  EXPECT_EQ(c.vertices_used, 7);
+  EXPECT_EQ(c.samples_unused, 1);
+  EXPECT_EQ(c.euler, 7 - 12 + 8);
+  EXPECT_EQ(c.comp[0].vertices, 4);
+  EXPECT_EQ(c.comp[1].vertices, 4);
+  EXPECT_EQ(c.comp[0].genus, 0);
+  EXPECT_EQ(c.comp[1].genus, 0);
+  EXPECT_MSG(!c.manifold && !c.closed && c.oriented, "%d %d %d", c.manifold,
+             c.closed, c.oriented);
   expect_bad(&c, SCS_SURF_TWO_SPHERES, 0, "non-manifold vertices");
   scs_meshcheck_free(&c);
 
@@ -221,9 +224,9 @@ static void test_pinched(void) {
   static const double xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0};
   static const uint32_t tri[] = {0, 1, 2, 0, 3, 4};
   check(5, xyz, tri, 2, NULL, &c);
-  TS_EQ_U64(c.nonmanifold_vertices, 1);
-  TS_EQ_U64(c.boundary_loops, 2);
-  TS_EQ_U64(c.components, 2);
+  EXPECT_EQ(c.nonmanifold_vertices, 1);
+  EXPECT_EQ(c.boundary_loops, 2);
+  EXPECT_EQ(c.components, 2);
   scs_meshcheck_free(&c);
 }
 
@@ -259,12 +262,12 @@ static void test_genus(void) {
   torus(&m);
   scs_meshcheck_t c;
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
-  TS_EQ_U64(c.faces, 48);
-  TS_EQ_U64(c.edges, 72);
-  TS_EQ_I64(c.euler, 0);
-  TS_EQ_I64(c.genus_total, 1);
-  TS_TRUE(c.closed && c.oriented, "%d %d", c.closed, c.oriented);
-  TS_LT(0, c.volume);
+  EXPECT_EQ(c.faces, 48);
+  EXPECT_EQ(c.edges, 72);
+  EXPECT_EQ(c.euler, 0);
+  EXPECT_EQ(c.genus_total, 1);
+  EXPECT_MSG(c.closed && c.oriented, "%d %d", c.closed, c.oriented);
+  EXPECT_LT(0, c.volume);
   expect_ok(&c, SCS_SURF_TORUS, SCS_EXPECT_ALL_USED | SCS_EXPECT_OUTWARD);
   expect_bad(&c, SCS_SURF_SPHERE, 0, "genus 1 where 0 was expected");
   scs_meshcheck_free(&c);
@@ -281,15 +284,15 @@ static void test_components(void) {
   add(&m, oct_xyz, 6, oct_tri, 8, 1.6, 0);
   scs_meshcheck_t c;
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
-  TS_EQ_U64(c.components, 2);
-  TS_EQ_U64(c.closed_components, 2);
-  TS_EQ_U64(c.edges, 24);
-  TS_EQ_I64(c.euler, 4);
-  TS_EQ_U64(c.comp[0].triangles, 8);
-  TS_EQ_U64(c.comp[1].edges, 12);
+  EXPECT_EQ(c.components, 2);
+  EXPECT_EQ(c.closed_components, 2);
+  EXPECT_EQ(c.edges, 24);
+  EXPECT_EQ(c.euler, 4);
+  EXPECT_EQ(c.comp[0].triangles, 8);
+  EXPECT_EQ(c.comp[1].edges, 12);
   /* Eight equilateral faces of side sqrt(2); volume 4/3 each. */
-  TS_NEAR(c.area, 2 * 4 * 1.7320508075688772, 1e-13);
-  TS_NEAR(c.volume, 8.0 / 3, 1e-14);
+  EXPECT_NEAR(c.area, 2 * 4 * 1.7320508075688772, 1e-13);
+  EXPECT_NEAR(c.volume, 8.0 / 3, 1e-14);
   expect_ok(&c, SCS_SURF_TWO_SPHERES, SCS_EXPECT_ALL_USED | SCS_EXPECT_OUTWARD);
   expect_bad(&c, SCS_SURF_SPHERE, 0, "2 components, expected 1");
   scs_meshcheck_free(&c);
@@ -302,8 +305,8 @@ static void test_components(void) {
   for (size_t i = 18; i < 36; i++)
     m.xyz[i] *= 0.5;
   check(m.n, m.xyz, m.tri, m.nt, NULL, &c);
-  TS_EQ_U64(c.components, 2);
-  TS_NEAR(c.comp[1].volume, 4.0 / 3 / 8, 1e-15);
+  EXPECT_EQ(c.components, 2);
+  EXPECT_NEAR(c.comp[1].volume, 4.0 / 3 / 8, 1e-15);
   expect_ok(&c, SCS_SURF_NESTED_SPHERES, SCS_EXPECT_OUTWARD);
   scs_meshcheck_free(&c);
 }
@@ -315,21 +318,21 @@ static void test_unused(void) {
   memcpy(xyz + 18, oct_xyz, 6 * sizeof *xyz);
   scs_meshcheck_t c;
   check(8, xyz, oct_tri, 8, NULL, &c);
-  TS_EQ_U64(c.samples_unused, 2);
-  TS_EQ_U64(c.vertices_used, 6);
+  EXPECT_EQ(c.samples_unused, 2);
+  EXPECT_EQ(c.vertices_used, 6);
   expect_ok(&c, SCS_SURF_SPHERE, 0);
   expect_bad(&c, SCS_SURF_SPHERE, SCS_EXPECT_ALL_USED, "2 samples unused");
   scs_meshcheck_free(&c);
   unsigned char ignore[8] = {0, 0, 0, 0, 0, 0, 1, 0};
   check(8, xyz, oct_tri, 8, ignore, &c);
-  TS_EQ_U64(c.samples_unused, 1);
+  EXPECT_EQ(c.samples_unused, 1);
   scs_meshcheck_free(&c);
   ignore[7] = 1;
   /* Ignoring a vertex that is used changes nothing. */
   ignore[0] = 1;
   check(8, xyz, oct_tri, 8, ignore, &c);
-  TS_EQ_U64(c.samples_unused, 0);
-  TS_EQ_U64(c.vertices_used, 6);
+  EXPECT_EQ(c.samples_unused, 0);
+  EXPECT_EQ(c.vertices_used, 6);
   expect_ok(&c, SCS_SURF_SPHERE, SCS_EXPECT_ALL_USED);
   scs_meshcheck_free(&c);
 }
@@ -342,77 +345,78 @@ static void test_left_out(void) {
   memcpy(tri + 12, extra, sizeof extra);
   scs_meshcheck_t c;
   check(4, tet_xyz, tri, 10, NULL, &c);
-  TS_EQ_U64(c.triangles, 10);
-  TS_EQ_U64(c.out_of_range, 2);
-  TS_EQ_U64(c.degenerate, 2);
-  TS_EQ_U64(c.duplicates, 2);
-  TS_EQ_U64(c.faces, 4);
-  TS_EQ_U64(c.edges, 6);
-  TS_TRUE(!c.manifold && c.oriented, "%d %d", c.manifold, c.oriented);
-  TS_NEAR(c.volume, 1.0 / 6, 1e-15);
+  EXPECT_EQ(c.triangles, 10);
+  EXPECT_EQ(c.out_of_range, 2);
+  EXPECT_EQ(c.degenerate, 2);
+  EXPECT_EQ(c.duplicates, 2);
+  EXPECT_EQ(c.faces, 4);
+  EXPECT_EQ(c.edges, 6);
+  EXPECT_MSG(!c.manifold && c.oriented, "%d %d", c.manifold, c.oriented);
+  EXPECT_NEAR(c.volume, 1.0 / 6, 1e-15);
   expect_bad(&c, SCS_SURF_SPHERE, 0, "2 triangles with an index out of range");
   scs_meshcheck_free(&c);
   /* With only the duplicates left in, they are what fails. */
   memcpy(tri + 12, extra + 6, 6 * sizeof *tri);
   check(4, tet_xyz, tri, 6, NULL, &c);
-  TS_EQ_U64(c.duplicates, 2);
+  EXPECT_EQ(c.duplicates, 2);
   expect_bad(&c, SCS_SURF_SPHERE, 0, "2 duplicate triangles");
   scs_meshcheck_free(&c);
   /* A duplicate keeps its first copy, whichever way that one faces. */
   uint32_t first_flipped[15] = {0, 1, 2};
   memcpy(first_flipped + 3, tet_tri, sizeof tet_tri);
   check(4, tet_xyz, first_flipped, 5, NULL, &c);
-  TS_EQ_U64(c.duplicates, 1);
-  TS_EQ_U64(c.orientation_errors, 3);
+  EXPECT_EQ(c.duplicates, 1);
+  EXPECT_EQ(c.orientation_errors, 3);
   scs_meshcheck_free(&c);
 }
 
 static void test_arguments(void) {
   scs_meshcheck_t c;
   memset(&c, 0xff, sizeof c);
-  TS_EQ_I64(scs_meshcheck(4, tet_xyz, NULL, 4, NULL, &c), SCS_EINVAL);
-  TS_EQ_U64(c.faces, 0);
-  TS_TRUE(c.comp == NULL, "comp not reset");
-  TS_EQ_I64(scs_meshcheck(4, tet_xyz, tet_tri, 4, NULL, NULL), SCS_EINVAL);
-  TS_EQ_I64(scs_meshcheck((size_t)1 << 32, NULL, tet_tri, 4, NULL, &c),
+  EXPECT_EQ(scs_meshcheck(4, tet_xyz, NULL, 4, NULL, &c), SCS_EINVAL);
+  EXPECT_EQ(c.faces, 0);
+  EXPECT_MSG(c.comp == NULL, "comp not reset");
+  EXPECT_EQ(scs_meshcheck(4, tet_xyz, tet_tri, 4, NULL, NULL), SCS_EINVAL);
+  EXPECT_EQ(scs_meshcheck((size_t)1 << 32, NULL, tet_tri, 4, NULL, &c),
             SCS_EINVAL);
   /* Nothing at all is a valid, empty measurement. */
   check(0, NULL, NULL, 0, NULL, &c);
-  TS_EQ_U64(c.components, 0);
-  TS_TRUE(c.closed && c.manifold, "empty mesh flags");
+  EXPECT_EQ(c.components, 0);
+  EXPECT_MSG(c.closed && c.manifold, "empty mesh flags");
   expect_bad(&c, SCS_SURF_SPHERE, 0, "0 components");
   scs_meshcheck_free(&c);
   /* Without coordinates, topology only. */
   check(4, NULL, tet_tri, 4, NULL, &c);
-  TS_EQ_I64(c.genus_total, 0);
-  TS_NEAR(c.area, 0, 0);
-  TS_NEAR(c.volume, 0, 0);
+  EXPECT_EQ(c.genus_total, 0);
+  EXPECT_NEAR(c.area, 0, 0);
+  EXPECT_NEAR(c.volume, 0, 0);
   scs_meshcheck_free(&c);
   char why[8];
-  TS_EQ_I64(scs_meshcheck_expect(NULL, SCS_SURF_SPHERE, 0, why, sizeof why), 0);
-  TS_EQ_I64(scs_meshcheck_expect(&c, SCS_SURF_COUNT, 0, NULL, 0), 0);
+  EXPECT_EQ(scs_meshcheck_expect(NULL, SCS_SURF_SPHERE, 0, why, sizeof why), 0);
+  EXPECT_EQ(scs_meshcheck_expect(&c, SCS_SURF_COUNT, 0, NULL, 0), 0);
 }
 
 static void test_distance(void) {
   scs_distcheck_t d;
-  TS_EQ_I64(
-      scs_mesh_distance_check(SCS_SURF_SPHERE, 6, oct_xyz, oct_tri, 8, 1e-12, &d),
-      SCS_OK);
-  TS_EQ_U64(d.vertices, 6);
-  TS_EQ_U64(d.beyond, 0);
-  TS_NEAR(d.max_distance, 0, 1e-15);
+  EXPECT_EQ(scs_mesh_distance_check(SCS_SURF_SPHERE, 6, oct_xyz, oct_tri, 8,
+                                    1e-12, &d),
+            SCS_OK);
+  EXPECT_EQ(d.vertices, 6);
+  EXPECT_EQ(d.beyond, 0);
+  EXPECT_NEAR(d.max_distance, 0, 1e-15);
   double xyz[18];
   memcpy(xyz, oct_xyz, sizeof xyz);
   xyz[3 * 4 + 2] = 1.25;
   xyz[3 * 5 + 2] = -0.9;
-  TS_EQ_I64(
+  EXPECT_EQ(
       scs_mesh_distance_check(SCS_SURF_SPHERE, 6, xyz, oct_tri, 8, 0.15, &d),
       SCS_OK);
-  TS_EQ_U64(d.beyond, 1);
-  TS_EQ_U64(d.worst, 4);
-  TS_NEAR(d.max_distance, 0.25, 1e-15);
-  TS_EQ_I64(scs_mesh_distance_check(SCS_SURF_COUNT, 6, xyz, oct_tri, 8, 0.1, &d),
-            SCS_EINVAL);
+  EXPECT_EQ(d.beyond, 1);
+  EXPECT_EQ(d.worst, 4);
+  EXPECT_NEAR(d.max_distance, 0.25, 1e-15);
+  EXPECT_EQ(
+      scs_mesh_distance_check(SCS_SURF_COUNT, 6, xyz, oct_tri, 8, 0.1, &d),
+      SCS_EINVAL);
 }
 
 int main(void) {
@@ -428,5 +432,5 @@ int main(void) {
   test_left_out();
   test_arguments();
   test_distance();
-  return ts_exit_code();
+  return sct_finish("synth_meshcheck");
 }

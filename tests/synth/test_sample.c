@@ -7,9 +7,11 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include "sct_assert.h"
 #include "synth.h"
-#include "tsassert.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -25,10 +27,10 @@ static double *sample(scs_surface_t s, int d, size_t n, uint64_t seed) {
   for (int k = 0; k < 3; k++)
     xyz[3 * n + k] = guard;
   int rc = scs_sample_surface(s, d, n, seed, xyz);
-  TS_EQ_I64(rc, SCS_OK);
+  EXPECT_EQ(rc, SCS_OK);
   for (int k = 0; k < 3; k++)
-    TS_TRUE(xyz[3 * n + k] == guard, "%s/%s wrote past %zu points",
-            scs_surface_name(s), scs_density_name(d), n);
+    EXPECT_MSG(xyz[3 * n + k] == guard, "%s/%s wrote past %zu points",
+               scs_surface_name(s), scs_density_name(d), n);
   return xyz;
 }
 
@@ -39,13 +41,13 @@ static void test_on_surface(void) {
       double *a = sample((scs_surface_t)s, d, N, 42);
       double *b = sample((scs_surface_t)s, d, N, 42);
       double *c = sample((scs_surface_t)s, d, N, 43);
-      TS_TRUE(memcmp(a, b, 3 * N * sizeof *a) == 0,
-              "%s/%s: the same seed gave different points", info->name,
-              scs_density_name(d));
+      EXPECT_MSG(memcmp(a, b, 3 * N * sizeof *a) == 0,
+                 "%s/%s: the same seed gave different points", info->name,
+                 scs_density_name(d));
       size_t same = 0;
       for (size_t i = 0; i < N; i++)
         same += memcmp(a + 3 * i, c + 3 * i, 3 * sizeof *a) == 0;
-      TS_EQ_U64(same, 0);
+      EXPECT_EQ(same, 0);
       double worst = 0;
       size_t outside = 0;
       for (size_t i = 0; i < N; i++) {
@@ -57,9 +59,9 @@ static void test_on_surface(void) {
           outside += !(p[k] >= info->bbox_min[k] - 1e-12 &&
                        p[k] <= info->bbox_max[k] + 1e-12);
       }
-      TS_TRUE(worst <= 1e-9, "%s/%s: a point %.3g from the surface", info->name,
-              scs_density_name(d), worst);
-      TS_EQ_U64(outside, 0);
+      EXPECT_MSG(worst <= 1e-9, "%s/%s: a point %.3g from the surface",
+                 info->name, scs_density_name(d), worst);
+      EXPECT_EQ(outside, 0);
       free(a);
       free(b);
       free(c);
@@ -74,16 +76,17 @@ static void test_counts(void) {
       double *a = sample(SCS_SURF_TORUS, d, counts[i], 7);
       free(a);
     }
-  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM, 0, 1, NULL),
-            SCS_OK);
+  EXPECT_EQ(
+      scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM, 0, 1, NULL),
+      SCS_OK);
   double p[3];
-  TS_EQ_I64(scs_sample_surface(SCS_SURF_COUNT, 0, 1, 1, p), SCS_EINVAL);
-  TS_EQ_I64(scs_sample_surface((scs_surface_t)-1, 0, 1, 1, p), SCS_EINVAL);
-  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_COUNT, 1, 1, p),
+  EXPECT_EQ(scs_sample_surface(SCS_SURF_COUNT, 0, 1, 1, p), SCS_EINVAL);
+  EXPECT_EQ(scs_sample_surface((scs_surface_t)-1, 0, 1, 1, p), SCS_EINVAL);
+  EXPECT_EQ(scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_COUNT, 1, 1, p),
             SCS_EINVAL);
-  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, -1, 1, 1, p), SCS_EINVAL);
-  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, 0, 1, 1, NULL), SCS_EINVAL);
-  TS_EQ_I64(scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM,
+  EXPECT_EQ(scs_sample_surface(SCS_SURF_SPHERE, -1, 1, 1, p), SCS_EINVAL);
+  EXPECT_EQ(scs_sample_surface(SCS_SURF_SPHERE, 0, 1, 1, NULL), SCS_EINVAL);
+  EXPECT_EQ(scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM,
                                (size_t)600000000, 1, p),
             SCS_EINVAL);
 }
@@ -130,7 +133,7 @@ static void test_proportions(void) {
         }
       }
       double q = cases[c].expect, sd = sqrt(M * q * (1 - q));
-      TS_NEAR((double)hits, M * q, 5 * sd);
+      EXPECT_NEAR((double)hits, M * q, 5 * sd);
       free(a);
     }
   }
@@ -147,8 +150,8 @@ static void test_proportions(void) {
     flat_u += fabs(u[3 * i + 2]) > 0.29;
     flat_a += fabs(a[3 * i + 2]) > 0.29;
   }
-  TS_LT(2.5 * (double)tips_u, (double)tips_a);
-  TS_LT((double)flat_a, 0.9 * (double)flat_u);
+  EXPECT_LT(2.5 * (double)tips_u, (double)tips_a);
+  EXPECT_LT((double)flat_a, 0.9 * (double)flat_u);
   free(u);
   free(a);
 }
@@ -156,22 +159,22 @@ static void test_proportions(void) {
 static void test_names(void) {
   for (int s = 0; s < SCS_SURF_COUNT; s++) {
     const char *name = scs_surface_name((scs_surface_t)s);
-    TS_EQ_I64(scs_surface_from_name(name), s);
-    TS_TRUE(strcmp(name, scs_surface_info((scs_surface_t)s)->name) == 0, "%s",
-            name);
+    EXPECT_EQ(scs_surface_from_name(name), s);
+    EXPECT_MSG(strcmp(name, scs_surface_info((scs_surface_t)s)->name) == 0,
+               "%s", name);
   }
-  TS_TRUE(strcmp(scs_surface_name(SCS_SURF_COUNT), "?") == 0, "bad name");
-  TS_TRUE(scs_surface_info(SCS_SURF_COUNT) == NULL, "info out of range");
-  TS_EQ_I64(scs_surface_from_name("cube"), -1);
-  TS_EQ_I64(scs_surface_from_name(NULL), -1);
+  EXPECT_MSG(strcmp(scs_surface_name(SCS_SURF_COUNT), "?") == 0, "bad name");
+  EXPECT_MSG(scs_surface_info(SCS_SURF_COUNT) == NULL, "info out of range");
+  EXPECT_EQ(scs_surface_from_name("cube"), -1);
+  EXPECT_EQ(scs_surface_from_name(NULL), -1);
   for (int d = 0; d < SCS_DENSITY_COUNT; d++)
-    TS_EQ_I64(scs_density_from_name(scs_density_name(d)), d);
-  TS_TRUE(strcmp(scs_density_name(SCS_DENSITY_COUNT), "?") == 0, "bad name");
-  TS_EQ_I64(scs_density_from_name("dense"), -1);
-  TS_EQ_I64(scs_density_from_name(NULL), -1);
-  TS_NEAR(scs_surface_spacing(SCS_SURF_SPHERE, 100),
-          sqrt(4 * 3.14159265358979323846 / 100), 1e-15);
-  TS_NEAR(scs_surface_spacing(SCS_SURF_SPHERE, 0), 0, 0);
+    EXPECT_EQ(scs_density_from_name(scs_density_name(d)), d);
+  EXPECT_MSG(strcmp(scs_density_name(SCS_DENSITY_COUNT), "?") == 0, "bad name");
+  EXPECT_EQ(scs_density_from_name("dense"), -1);
+  EXPECT_EQ(scs_density_from_name(NULL), -1);
+  EXPECT_NEAR(scs_surface_spacing(SCS_SURF_SPHERE, 100),
+              sqrt(4 * 3.14159265358979323846 / 100), 1e-15);
+  EXPECT_NEAR(scs_surface_spacing(SCS_SURF_SPHERE, 0), 0, 0);
 }
 
 int main(void) {
@@ -179,5 +182,5 @@ int main(void) {
   test_counts();
   test_proportions();
   test_names();
-  return ts_exit_code();
+  return sct_finish("synth_sample");
 }

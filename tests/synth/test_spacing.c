@@ -19,9 +19,11 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include "sct_assert.h"
 #include "synth.h"
-#include "tsassert.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -149,7 +151,7 @@ static double *sample(scs_surface_t s, int d, size_t n, uint64_t seed) {
   double *xyz = malloc(3 * n * sizeof *xyz);
   if (!xyz)
     abort();
-  TS_EQ_I64(scs_sample_surface(s, d, n, seed, xyz), SCS_OK);
+  EXPECT_EQ(scs_sample_surface(s, d, n, seed, xyz), SCS_OK);
   return xyz;
 }
 
@@ -159,10 +161,11 @@ static void check_spaced(scs_surface_t s, int d, size_t n, uint64_t seed) {
   double unit = scs_surface_spacing(s, n);
   double *nn = nearest(xyz, n, unit);
   stats_t st = stats_of(nn, n, unit);
-  TS_TRUE(st.min >= 0.63 && st.median >= 0.76 && st.median <= 0.80 &&
-              st.max <= 1.45,
-          "%s/%s n=%zu: nearest neighbours min %.3f median %.3f max %.3f",
-          scs_surface_name(s), scs_density_name(d), n, st.min, st.median, st.max);
+  EXPECT_MSG(st.min >= 0.63 && st.median >= 0.76 && st.median <= 0.80 &&
+                 st.max <= 1.45,
+             "%s/%s n=%zu: nearest neighbours min %.3f median %.3f max %.3f",
+             scs_surface_name(s), scs_density_name(d), n, st.min, st.median,
+             st.max);
   free(nn);
   free(xyz);
 }
@@ -188,8 +191,8 @@ static void test_random(void) {
     double unit = scs_surface_spacing((scs_surface_t)s, n);
     double *nn = nearest(xyz, n, unit);
     stats_t st = stats_of(nn, n, unit);
-    TS_NEAR(st.median, median, 0.012);
-    TS_LT(st.min, 0.1);
+    EXPECT_NEAR(st.median, median, 0.012);
+    EXPECT_LT(st.min, 0.1);
     free(nn);
     free(xyz);
   }
@@ -212,13 +215,13 @@ static void test_adaptive(void) {
     else
       out[n_out++] = nn[i];
   }
-  TS_NEAR((double)n_in / (double)n, 0.5, 0.02);
+  EXPECT_NEAR((double)n_in / (double)n, 0.5, 0.02);
   stats_t si = stats_of(in, n_in, 1), so = stats_of(out, n_out, 1);
-  TS_NEAR(so.median / si.median, 2.0, 0.15);
+  EXPECT_NEAR(so.median / si.median, 2.0, 0.15);
   /* Each sphere on its own is well spaced at its own density. */
   double unit_in = sqrt(3.14159265358979323846 * 0.25 * 4 / (double)n_in);
-  TS_TRUE(si.min / unit_in >= 0.55, "inner sphere: min %.3f units",
-          si.min / unit_in);
+  EXPECT_MSG(si.min / unit_in >= 0.55, "inner sphere: min %.3f units",
+             si.min / unit_in);
   free(in);
   free(out);
   free(nn);
@@ -239,11 +242,11 @@ static void test_adaptive(void) {
     if (fabs(xyz[3 * i + 2]) > 0.29)
       flat[n_flat++] = nn[i];
   }
-  TS_TRUE(n_tip > 100 && n_flat > 100, "%zu tip and %zu flat points", n_tip,
-          n_flat);
+  EXPECT_MSG(n_tip > 100 && n_flat > 100, "%zu tip and %zu flat points", n_tip,
+             n_flat);
   double ratio =
       stats_of(flat, n_flat, 1).median / stats_of(tip, n_tip, 1).median;
-  TS_TRUE(ratio > 1.8 && ratio < 2.6, "flat / tip spacing %.3f", ratio);
+  EXPECT_MSG(ratio > 1.8 && ratio < 2.6, "flat / tip spacing %.3f", ratio);
   free(tip);
   free(flat);
   free(nn);
@@ -268,7 +271,7 @@ static void test_nearest(void) {
               (xyz[3 * i + k] - xyz[3 * j + k]);
       best = d2 < best ? d2 : best;
     }
-    TS_NEAR(nn[i], sqrt(best), 0);
+    EXPECT_NEAR(nn[i], sqrt(best), 0);
   }
   free(nn);
   free(xyz);
@@ -279,5 +282,5 @@ int main(void) {
   test_uniform();
   test_random();
   test_adaptive();
-  return ts_exit_code();
+  return sct_finish("synth_spacing");
 }
