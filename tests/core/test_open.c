@@ -25,7 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "check.h"
+#include "diag.h"
 #include "shortcrust.h"
 #include "synth.h"
 #include "testsupport.h"
@@ -276,15 +276,15 @@ int main(int argc, char **argv) {
   double t0 = sct_seconds();
   int rc = sc_reconstruct(xyz, n, &p, &m, msg, sizeof msg);
   double t1 = sct_seconds();
-  CHECK_EQ_INT(rc, 0);
+  EXPECT_EQ(rc, 0);
   if (rc != 0) {
     fprintf(stderr, "%s\n", msg);
     free(xyz);
-    return CHECK_DONE();
+    return sct_finish("core_open");
   }
   scs_meshcheck_t c;
-  CHECK_EQ_INT(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
-               0);
+  EXPECT_EQ(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
+            0);
   char line[512];
   printf("%s %s n=%zu: %s path=%s boundary_samples=%llu holes=%llu/%llu "
          "handles_cut=%llu (%.2f s)\n",
@@ -294,32 +294,32 @@ int main(int argc, char **argv) {
          (unsigned long long)m->diag.holes_filled,
          (unsigned long long)m->diag.hole_triangles,
          (unsigned long long)m->diag.handles_cut, t1 - t0);
-  CHECK(c.manifold);
-  CHECK(c.oriented);
-  CHECK_EQ_INT(c.nonmanifold_edges, 0);
-  CHECK_EQ_INT(c.nonmanifold_vertices, 0);
-  CHECK_EQ_INT(c.components, 1);
-  CHECK_EQ_INT(m->diag.nonmanifold_edges, 0);
-  CHECK_EQ_INT(m->diag.nonmanifold_vertices, 0);
-  CHECK_EQ_INT(m->diag.boundary_loops, c.boundary_loops);
-  CHECK_DIAG_COUNTS(m->diag, c);
+  EXPECT(c.manifold);
+  EXPECT(c.oriented);
+  EXPECT_EQ(c.nonmanifold_edges, 0);
+  EXPECT_EQ(c.nonmanifold_vertices, 0);
+  EXPECT_EQ(c.components, 1);
+  EXPECT_EQ(m->diag.nonmanifold_edges, 0);
+  EXPECT_EQ(m->diag.nonmanifold_vertices, 0);
+  EXPECT_EQ(m->diag.boundary_loops, c.boundary_loops);
+  EXPECT_DIAG_COUNTS(m->diag, c);
 
   if (mode == SC_MODE_WATERTIGHT) {
-    CHECK(c.closed);
-    CHECK_EQ_INT(c.genus_total, closed_genus[s]);
-    CHECK(c.volume > 0);
-    CHECK(m->diag.closed);
-    CHECK(m->diag.path == SC_PATH_WATERTIGHT ||
-          m->diag.path == SC_PATH_WATERTIGHT_FILL);
+    EXPECT(c.closed);
+    EXPECT_EQ(c.genus_total, closed_genus[s]);
+    EXPECT_GT(c.volume, 0);
+    EXPECT(m->diag.closed);
+    EXPECT(m->diag.path == SC_PATH_WATERTIGHT ||
+           m->diag.path == SC_PATH_WATERTIGHT_FILL);
     if (labels)
-      CHECK_EQ_INT(m->diag.path, SC_PATH_WATERTIGHT);
+      EXPECT_EQ(m->diag.path, SC_PATH_WATERTIGHT);
     /* Closing may bury a sample or two of the rim inside. */
-    CHECK(c.samples_unused * 100 <= n);
+    EXPECT_LE(c.samples_unused * 100, n);
   } else {
-    CHECK_EQ_INT(c.boundary_loops, open_loops[s]);
-    CHECK_EQ_INT(m->diag.path, SC_PATH_BOUNDARY);
-    CHECK(m->diag.boundary_samples > 0);
-    CHECK(c.samples_unused * 200 <= n);
+    EXPECT_EQ(c.boundary_loops, open_loops[s]);
+    EXPECT_EQ(m->diag.path, SC_PATH_BOUNDARY);
+    EXPECT_GT(m->diag.boundary_samples, 0);
+    EXPECT_LE(c.samples_unused * 200, n);
     /* Every vertex of a boundary edge lies near the true boundary; and the
      * longest loop is at least as long as the shortest true curve needs. */
     unsigned char *on = malloc(n);
@@ -336,15 +336,15 @@ int main(int argc, char **argv) {
       }
       printf("boundary vertices: worst %.3g spacings from the true curve\n",
              worst / spacing);
-      CHECK_EQ_INT(far, 0);
+      EXPECT_EQ(far, 0);
       free(on);
     }
     /* The loops follow the boundary samples, which may be a few spacings
      * apart along the curve; but they are loops, not slivers. */
-    CHECK(m->diag.longest_loop >= 8);
+    EXPECT_GE(m->diag.longest_loop, 8);
   }
   scs_meshcheck_free(&c);
   sc_mesh_free(m);
   free(xyz);
-  return CHECK_DONE();
+  return sct_finish("core_open");
 }

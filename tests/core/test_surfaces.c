@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sct_assert.h"
 #include "shortcrust.h"
 #include "synth.h"
 #include "testsupport.h"
@@ -63,12 +64,11 @@ int main(int argc, char **argv) {
   int rc = sc_reconstruct(xyz, n, &params, &mesh, msg, sizeof msg);
   double t1 = sct_seconds();
   if (rc != 0) {
-    fprintf(stderr, "FAIL: sc_reconstruct returned %d (%s): %s\n", rc,
-            sc_err_name(rc), msg);
+    EXPECT_FAIL("sc_reconstruct returned %d (%s): %s", rc, sc_err_name(rc),
+                msg);
     return 1;
   }
 
-  int failures = 0;
   scs_meshcheck_t c;
   if (scs_meshcheck(n, xyz, mesh->triangles, mesh->triangle_count, NULL, &c)) {
     fprintf(stderr, "meshcheck failed\n");
@@ -85,13 +85,11 @@ int main(int argc, char **argv) {
   if (!scs_meshcheck_expect(
           &c, surf, (scan_mode ? 0u : SCS_EXPECT_ALL_USED) | SCS_EXPECT_OUTWARD,
           why, sizeof why)) {
-    fprintf(stderr, "FAIL: %s\n", why);
-    ++failures;
+    EXPECT_FAIL("%s", why);
   }
   if (scan_mode && c.samples_unused * 1000 > n) {
-    fprintf(stderr, "FAIL: %llu of %zu samples unused\n",
-            (unsigned long long)c.samples_unused, n);
-    ++failures;
+    EXPECT_FAIL("%llu of %zu samples unused",
+                (unsigned long long)c.samples_unused, n);
   }
 
   /* The core's own diagnostics must agree with the independent checker. */
@@ -102,19 +100,17 @@ int main(int argc, char **argv) {
       d->boundary_edges != c.boundary_edges ||
       d->nonmanifold_edges != c.nonmanifold_edges ||
       d->nonmanifold_vertices != c.nonmanifold_vertices) {
-    fprintf(stderr,
-            "FAIL: diagnostics disagree with the checker: triangles %llu/%llu "
-            "components %llu/%llu closed %d/%d genus %lld/%lld unused "
-            "%llu/%llu boundary %llu/%llu\n",
-            (unsigned long long)d->triangles, (unsigned long long)c.faces,
-            (unsigned long long)d->components,
-            (unsigned long long)c.components, d->closed, c.closed,
-            (long long)d->genus, (long long)c.genus_total,
-            (unsigned long long)d->samples_unused,
-            (unsigned long long)c.samples_unused,
-            (unsigned long long)d->boundary_edges,
-            (unsigned long long)c.boundary_edges);
-    ++failures;
+    EXPECT_FAIL("diagnostics disagree with the checker: triangles %llu/%llu "
+                "components %llu/%llu closed %d/%d genus %lld/%lld unused "
+                "%llu/%llu boundary %llu/%llu",
+                (unsigned long long)d->triangles, (unsigned long long)c.faces,
+                (unsigned long long)d->components,
+                (unsigned long long)c.components, d->closed, c.closed,
+                (long long)d->genus, (long long)c.genus_total,
+                (unsigned long long)d->samples_unused,
+                (unsigned long long)c.samples_unused,
+                (unsigned long long)d->boundary_edges,
+                (unsigned long long)c.boundary_edges);
   }
 
   /* Vertices are samples, so they lie on the surface to rounding error. */
@@ -122,9 +118,8 @@ int main(int argc, char **argv) {
   if (scs_mesh_distance_check(surf, n, xyz, mesh->triangles,
                               mesh->triangle_count, 1e-9, &dc) != 0 ||
       dc.beyond != 0) {
-    fprintf(stderr, "FAIL: %llu vertices off the surface (max %g)\n",
-            (unsigned long long)dc.beyond, dc.max_distance);
-    ++failures;
+    EXPECT_FAIL("%llu vertices off the surface (max %g)",
+                (unsigned long long)dc.beyond, dc.max_distance);
   }
 
   /* Normals: unit length, and pointing outward like the true normal. */
@@ -139,9 +134,7 @@ int main(int argc, char **argv) {
       ++bad_normals;
   }
   if (bad_normals > n / 1000) {
-    fprintf(stderr, "FAIL: %zu of %zu normals not unit or not outward\n",
-            bad_normals, n);
-    ++failures;
+    EXPECT_FAIL("%zu of %zu normals not unit or not outward", bad_normals, n);
   }
 
   /* Every component's genus as reported per component. */
@@ -149,13 +142,12 @@ int main(int argc, char **argv) {
   for (size_t i = 0; i < mesh->component_count; ++i)
     sum += mesh->component_genus[i];
   if (mesh->component_count != c.components || sum != c.genus_total) {
-    fprintf(stderr, "FAIL: component_genus lists %zu components, sum %lld\n",
-            mesh->component_count, (long long)sum);
-    ++failures;
+    EXPECT_FAIL("component_genus lists %zu components, sum %lld",
+                mesh->component_count, (long long)sum);
   }
 
   scs_meshcheck_free(&c);
   sc_mesh_free(mesh);
   free(xyz);
-  return failures ? 1 : 0;
+  return sct_finish("core_surfaces");
 }
