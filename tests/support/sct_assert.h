@@ -95,7 +95,9 @@ int sct_contains_(const char *s, const char *part, const char *file, int line,
                   const char *es, const char *ep);
 int sct_mem_(const void *a, size_t alen, const void *b, size_t blen,
              const char *file, int line, const char *ea, const char *eb);
-int sct_null_(int want_null, const volatile void *p, const char *file, int line,
+/* The pointer as an integer: a pointer parameter would tell the compiler
+ * that the function reads what it points to. */
+int sct_null_(int want_null, uintptr_t p, const char *file, int line,
               const char *ep);
 int sct_code_(long long a, long long b, const char *(*name)(int),
               const char *file, int line, const char *ea, const char *eb);
@@ -191,7 +193,8 @@ template <typename T> static inline sct_value_t sct_value_(T v) {
 #define SCT_MEM_(F, a, alen, b, blen, ea, eb)                                  \
   SCT_DO_(F, sct_mem_((a), (alen), (b), (blen), __FILE__, __LINE__, ea, eb))
 #define SCT_NULL_(F, want, p, ep)                                              \
-  SCT_DO_(F, sct_null_(want, (p), __FILE__, __LINE__, ep))
+  SCT_DO_(F, sct_null_(want, (uintptr_t)(const volatile void *)(p), __FILE__,  \
+                       __LINE__, ep))
 #define SCT_CODE_(F, a, b, name, ea, eb)                                       \
   SCT_DO_(F, sct_code_((long long)(a), (long long)(b), (name), __FILE__,       \
                        __LINE__, ea, eb))
