@@ -10,8 +10,13 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <ctype.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "sct_assert.h"
+#include "scproto.h"
 
 /* Splits a markdown table row into at most max trimmed cells; returns the
  * number of cells, or 0 for a line that is not a row. */
