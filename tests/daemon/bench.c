@@ -429,8 +429,9 @@ int main(int argc, char **argv) {
     return 2;
   }
   char *fake[] = {argv[0], (char *)daemon, NULL};
-  scdt_init(2, fake);
+  scdt_setup(2, fake);
   latency(points, repeat);
   throughput(job_points, jobs, wmax, repeat);
-  return scdt_finish();
+  scdt_cleanup(0);
+  return 0;
 }

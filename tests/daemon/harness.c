@@ -19,8 +19,6 @@
 
 #include "synth.h"
 
-atomic_int scdt_failures;
-
 static const char *daemon_path;
 /* What scdt_finish() needs of every daemon, copied: tests keep their
  * scdt_daemon_t wherever they like, on the stack too. */
@@ -32,7 +30,7 @@ static struct record {
 } records[SCDT_MAX_DAEMONS];
 static int nrecords;
 
-void scdt_init(int argc, char **argv) {
+void scdt_setup(int argc, char **argv) {
   signal(SIGPIPE, SIG_IGN);
   if (argc < 2) {
     fprintf(stderr, "usage: %s PATH-TO-SHORTCRUSTD\n", argv[0]);
@@ -79,8 +77,7 @@ static void remove_dir(const char *dir) {
   rmdir(dir);
 }
 
-int scdt_finish(void) {
-  int failed = atomic_load(&scdt_failures);
+void scdt_cleanup(int show_logs) {
   for (int i = 0; i < nrecords; i++) {
     struct record *r = &records[i];
     if (r->pid > 0) {
@@ -88,17 +85,12 @@ int scdt_finish(void) {
       waitpid(r->pid, NULL, 0);
       r->pid = 0;
     }
-    if (failed || getenv("SCDT_SHOW_LOGS"))
+    if (show_logs || getenv("SCDT_SHOW_LOGS"))
       print_log(r->log);
     remove_dir(r->dir);
   }
   nrecords = 0;
-  if (failed)
-    fprintf(stderr, "%d check(s) failed\n", failed);
-  return failed ? 1 : 0;
 }
-
-void scdt_abort(void) { exit(scdt_finish() ? 1 : 1); }
 
 int scdt_daemon_prepare(scdt_daemon_t *d) {
   memset(d, 0, sizeof *d);
@@ -267,30 +259,6 @@ double *scdt_sample(int surface, size_t n, uint64_t seed) {
 
 double *scdt_sample_random(int surface, size_t n, uint64_t seed) {
   return sample(surface, SCS_DENSITY_UNIFORM_RANDOM, n, seed);
-}
-
-void scdt_run_ok(scdt_conn_t *c, uint32_t id, int surface, const double *xyz,
-                 size_t n, int timeout_ms, const char *when) {
-  scdt_job_t j;
-  scdt_job_init(&j, id, xyz, n);
-  scdt_job_t *pj = &j;
-  char why[512] = "";
-  CHECK(scdt_job_send(c, &j) == 0, "%s: send", when);
-  CHECK(scdt_collect(c, &pj, 1, timeout_ms, why, sizeof why) == 0, "%s: %s",
-        when, why);
-  CHECK(scdt_mesh_ok(surface, &j, why, sizeof why), "%s: %s", when, why);
-  scdt_job_reset(&j);
-}
-
-void scdt_check_serving(const char *sock, int surface, const double *xyz,
-                        size_t n, int timeout_ms, const char *when) {
-  scdt_conn_t *c;
-  int rc = scdt_open(sock, 1u << 20, &c);
-  CHECK(rc == 0, "%s: cannot connect: %d", when, rc);
-  if (rc != 0)
-    return;
-  scdt_run_ok(c, 1, surface, xyz, n, timeout_ms, when);
-  scdt_close(c);
 }
 
 int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {
