@@ -30,7 +30,7 @@
 
 #include "files.h"
 #include "shortcrust_client.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #ifndef SC_VERSION
 #define SC_VERSION "unknown"
@@ -42,12 +42,12 @@
 #define LOAD_SHOW_FAILURES 5
 #define LOAD_MAX_CODES 32
 
-static const sc_surface_t surfaces[] = {SC_SURF_SPHERE, SC_SURF_TORUS,
-                                        SC_SURF_GENUS2};
+static const scs_surface_t surfaces[] = {SCS_SURF_SPHERE, SCS_SURF_TORUS,
+                                         SCS_SURF_GENUS2};
 
 typedef struct input {
   const char *name; /* surface name or file path */
-  int surface;      /* sc_surface_t, or -1 for a file */
+  int surface;      /* scs_surface_t, or -1 for a file */
   double *xyz;
   uint64_t n;
 } input_t;
@@ -162,17 +162,17 @@ static void verify(tally_t *t, const input_t *in, const sc_client_job_t *job) {
   sc_client_mesh_t m;
   sc_client_job_mesh(job, &m);
   t->verified++;
-  sc_meshcheck_t mc;
-  if (sc_meshcheck((size_t)in->n, in->xyz, m.triangles,
-                   (size_t)m.triangle_count, NULL, &mc) != SC_TS_OK) {
+  scs_meshcheck_t mc;
+  if (scs_meshcheck((size_t)in->n, in->xyz, m.triangles,
+                    (size_t)m.triangle_count, NULL, &mc) != SCS_OK) {
     verify_failed(t, "%s: the mesh checker could not run", in->name);
     return;
   }
   char why[256] = "", sum[256];
   int ok;
   if (in->surface >= 0) {
-    ok = sc_meshcheck_expect(&mc, (sc_surface_t)in->surface, SC_EXPECT_OUTWARD,
-                             why, sizeof why);
+    ok = scs_meshcheck_expect(&mc, (scs_surface_t)in->surface,
+                              SCS_EXPECT_OUTWARD, why, sizeof why);
   } else {
     ok = mc.out_of_range == 0 && mc.manifold;
     if (!ok)
@@ -190,8 +190,8 @@ static void verify(tally_t *t, const input_t *in, const sc_client_job_t *job) {
   if (!ok)
     verify_failed(t, "%s (%llu points): %s; %s", in->name,
                   (unsigned long long)in->n, why,
-                  sc_meshcheck_summary(&mc, sum, sizeof sum));
-  sc_meshcheck_free(&mc);
+                  scs_meshcheck_summary(&mc, sum, sizeof sum));
+  scs_meshcheck_free(&mc);
 }
 
 /* A job in flight on a connection. */
@@ -598,12 +598,12 @@ int main(int argc, char **argv) {
     for (size_t i = 0; cfg.inputs && i < cfg.ninputs; i++) {
       input_t *in = &cfg.inputs[i];
       in->surface = surfaces[i % (sizeof surfaces / sizeof surfaces[0])];
-      in->name = sc_surface_name((sc_surface_t)in->surface);
+      in->name = scs_surface_name((scs_surface_t)in->surface);
       in->n = points;
       in->xyz = malloc((size_t)points * 3 * sizeof(double));
       if (!in->xyz ||
-          sc_sample_surface((sc_surface_t)in->surface, SC_DENSITY_UNIFORM,
-                            (size_t)points, 1000 + i, in->xyz) != SC_TS_OK) {
+          scs_sample_surface((scs_surface_t)in->surface, SCS_DENSITY_UNIFORM,
+                             (size_t)points, 1000 + i, in->xyz) != SCS_OK) {
         say("cannot make a sample of %llu points", (unsigned long long)points);
         return 1;
       }

@@ -24,7 +24,7 @@
 #include <unistd.h>
 
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 namespace {
 
@@ -111,8 +111,8 @@ template <class F> Result in_child(F f) {
 
 void check_mesh(size_t n, const double *xyz, const uint32_t *tri, size_t nt,
                 Result &r) {
-  sc_meshcheck_t c;
-  if (sc_meshcheck(n, xyz, tri, nt, nullptr, &c) != 0)
+  scs_meshcheck_t c;
+  if (scs_meshcheck(n, xyz, tri, nt, nullptr, &c) != 0)
     return;
   r.triangles = c.faces;
   r.unused = c.samples_unused;
@@ -122,7 +122,7 @@ void check_mesh(size_t n, const double *xyz, const uint32_t *tri, size_t nt,
   r.manifold = c.manifold;
   r.genus = c.genus_total;
   r.mesh = 1;
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
 }
 
 // The points as CGAL wants them; the copy is part of what a CGAL user pays.
@@ -232,7 +232,7 @@ void print_row(const char *name, const Result &r, size_t n) {
 int main(int argc, char **argv) {
   (void)sc_tune_allocator(); // as the command line does
   std::vector<size_t> sizes{100000, 1000000};
-  int surface = SC_SURF_TORUS, density = SC_DENSITY_UNIFORM_RANDOM;
+  int surface = SCS_SURF_TORUS, density = SCS_DENSITY_UNIFORM_RANDOM;
   int threads = int(std::thread::hardware_concurrency());
   bool peer = true;
   size_t peer_max = 1000000;
@@ -263,9 +263,9 @@ int main(int argc, char **argv) {
         at = comma + 1;
       }
     } else if (a == "--surface") {
-      surface = sc_surface_from_name(value());
+      surface = scs_surface_from_name(value());
     } else if (a == "--density") {
-      density = sc_density_from_name(value());
+      density = scs_density_from_name(value());
     } else if (a == "--threads") {
       threads = std::atoi(value());
     } else if (a == "--no-peer") {
@@ -293,14 +293,14 @@ int main(int argc, char **argv) {
   for (size_t n : sizes) {
     std::vector<double> xyz(3 * n);
     double t0 = now();
-    if (sc_sample_surface(sc_surface_t(surface), density, n, seed,
-                          xyz.data()) != 0) {
+    if (scs_sample_surface(scs_surface_t(surface), density, n, seed,
+                           xyz.data()) != 0) {
       std::fprintf(stderr, "shortcrust-bench: sampling failed\n");
       return 1;
     }
     std::printf("%zu points, %s, %s (sampled in %.1f s)\n", n,
-                sc_surface_name(sc_surface_t(surface)),
-                sc_density_name(density), now() - t0);
+                scs_surface_name(scs_surface_t(surface)),
+                scs_density_name(density), now() - t0);
     Result dt = run_cgal_delaunay(xyz.data(), n);
     print_row("cgal delaunay alone", dt, n);
     Result one = run_shortcrust(xyz.data(), n, 1);

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 
 #include "files.h"
-#include "testsupport.h"
+#include "synth.h"
 
 int main(int argc, char **argv) {
   if (argc != 2) {
@@ -26,8 +26,8 @@ int main(int argc, char **argv) {
     fprintf(stderr, "meshinfo: %s\n", msg);
     return 1;
   }
-  sc_meshcheck_t c;
-  if (sc_meshcheck(pts.count, pts.xyz, tri, ntri, NULL, &c) != 0) {
+  scs_meshcheck_t c;
+  if (scs_meshcheck(pts.count, pts.xyz, tri, ntri, NULL, &c) != 0) {
     fprintf(stderr, "meshinfo: checker failed\n");
     return 1;
   }
@@ -41,7 +41,7 @@ int main(int argc, char **argv) {
          pts.count, ntri, c.manifold, c.closed, c.oriented,
          (unsigned long long)c.components, (long long)c.genus_total,
          (unsigned long long)c.samples_unused, c.volume > 0, all);
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
   free(tri);
   sc_points_free(&pts);
   return 0;

@@ -10,9 +10,9 @@
 
 #include <stdint.h>
 
-#include "harness.h"
+#include "daemontest.h"
 #include "shortcrust_client.h"
-#include "testsupport.h"
+#include "synth.h"
 
 /* Generous: sanitizer builds run the core many times slower. */
 #define SCCT_WAIT_MS 300000
@@ -28,12 +28,12 @@ void scct_check_mesh(const char *what, int surface, const double *xyz,
                      uint64_t n, const sc_client_job_t *job);
 
 /* The status, with the job's message when it is not the expected one. */
-#define CHECK_STATUS(job, want)                                                \
+#define EXPECT_STATUS(job, want)                                               \
   do {                                                                         \
     int got_ = sc_client_job_status(job);                                      \
-    CHECK(got_ == (want), "status %s, expected %s: %s",                        \
-          sc_client_err_name(got_), sc_client_err_name(want),                  \
-          sc_client_job_message(job));                                         \
+    EXPECT_MSG(got_ == (want), "status %s, expected %s: %s",                   \
+               sc_client_err_name(got_), sc_client_err_name(want),             \
+               sc_client_job_message(job));                                    \
   } while (0)
 
 #endif /* SCCT_COMMON_H */

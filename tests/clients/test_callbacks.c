@@ -103,7 +103,7 @@ static void progress(void) {
   /* Big enough that the daemon reports its stages (at most ten times a
    * second), small enough for a sanitizer build. */
   const uint64_t n = 40000;
-  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 5);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, n, 5);
   sc_client_t *c = scct_open(d.sock, 0);
   seen_t s;
   memset(&s, 0, sizeof s);
@@ -113,22 +113,23 @@ static void progress(void) {
   p.progress = on_progress;
   p.progress_user = &s;
   sc_client_job_t *j;
-  REQUIRE(sc_client_submit(c, &p, xyz, n, &j) == 0, "submit: %s",
-          sc_client_last_error(c));
+  ASSERT_MSG(sc_client_submit(c, &p, xyz, n, &j) == 0, "submit: %s",
+             sc_client_last_error(c));
   /* The upload is over when submit returns. */
-  CHECK(s.upload >= 1 && s.last_upload == 1.0,
-        "upload: %u calls, last fraction %g", s.upload, s.last_upload);
-  CHECK_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), 0);
-  CHECK(s.server >= 1, "no progress from the daemon's stages");
-  CHECK(s.stage_mask & (1u << 1),
-        "no progress in the delaunay stage (mask "
-        "0x%x)",
-        s.stage_mask);
-  CHECK(s.download >= 1 && s.last_download == 1.0,
-        "download: %u calls, last fraction %g", s.download, s.last_download);
-  CHECK(!s.out_of_order, "progress out of order");
-  CHECK_EQ(s.reentry_rc, SC_CLIENT_ESTATE);
-  scct_check_mesh("sphere with progress", SC_SURF_SPHERE, xyz, n, j);
+  EXPECT_MSG(s.upload >= 1 && s.last_upload == 1.0,
+             "upload: %u calls, last fraction %g", s.upload, s.last_upload);
+  EXPECT_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), 0);
+  EXPECT_MSG(s.server >= 1, "no progress from the daemon's stages");
+  EXPECT_MSG(s.stage_mask & (1u << 1),
+             "no progress in the delaunay stage (mask "
+             "0x%x)",
+             s.stage_mask);
+  EXPECT_MSG(s.download >= 1 && s.last_download == 1.0,
+             "download: %u calls, last fraction %g", s.download,
+             s.last_download);
+  EXPECT_MSG(!s.out_of_order, "progress out of order");
+  EXPECT_EQ(s.reentry_rc, SC_CLIENT_ESTATE);
+  scct_check_mesh("sphere with progress", SCS_SURF_SPHERE, xyz, n, j);
   sc_client_job_free(j);
   sc_client_free(c);
   free(xyz);
@@ -136,56 +137,57 @@ static void progress(void) {
 
 static void chunks(void) {
   const uint64_t n = 5000;
-  double *xyz = scdt_sample(SC_SURF_GENUS2, n, 6);
+  double *xyz = scdt_sample(SCS_SURF_GENUS2, n, 6);
   /* The smallest frames: the mesh comes in many chunks. */
   sc_client_t *c = scct_open(d.sock, 4096);
   sc_client_params_t p;
   sc_client_params_init(&p);
   p.normals = 1;
   sc_client_job_t *whole;
-  REQUIRE(sc_client_submit(c, &p, xyz, n, &whole) == 0, "submit: %s",
-          sc_client_last_error(c));
+  ASSERT_MSG(sc_client_submit(c, &p, xyz, n, &whole) == 0, "submit: %s",
+             sc_client_last_error(c));
   collected_t k;
   memset(&k, 0, sizeof k);
   k.n = n;
   p.chunk = on_chunk;
   p.chunk_user = &k;
   sc_client_job_t *parts;
-  REQUIRE(sc_client_submit(c, &p, xyz, n, &parts) == 0, "submit: %s",
-          sc_client_last_error(c));
-  CHECK_EQ(sc_client_wait(c, whole, SCCT_WAIT_MS), 0);
-  CHECK_EQ(sc_client_wait(c, parts, SCCT_WAIT_MS), 0);
-  scct_check_mesh("genus 2, buffered", SC_SURF_GENUS2, xyz, n, whole);
+  ASSERT_MSG(sc_client_submit(c, &p, xyz, n, &parts) == 0, "submit: %s",
+             sc_client_last_error(c));
+  EXPECT_EQ(sc_client_wait(c, whole, SCCT_WAIT_MS), 0);
+  EXPECT_EQ(sc_client_wait(c, parts, SCCT_WAIT_MS), 0);
+  scct_check_mesh("genus 2, buffered", SCS_SURF_GENUS2, xyz, n, whole);
 
   sc_client_mesh_t a, b;
-  CHECK_EQ(sc_client_job_mesh(whole, &a), 0);
-  CHECK_EQ(sc_client_job_mesh(parts, &b), 0);
-  CHECK(!k.bad, "a chunk came out of order");
+  EXPECT_EQ(sc_client_job_mesh(whole, &a), 0);
+  EXPECT_EQ(sc_client_job_mesh(parts, &b), 0);
+  EXPECT_MSG(!k.bad, "a chunk came out of order");
   /* 338 triangles fit in a 4096-byte frame. */
-  CHECK(k.chunks > a.triangle_count / 338, "%u chunks for %llu triangles",
-        k.chunks, (unsigned long long)a.triangle_count);
-  CHECK(b.triangles == NULL && b.normals == NULL && b.genus == NULL,
-        "a job with a chunk callback kept its mesh");
-  CHECK_EQ(b.triangle_count, k.ntri);
-  CHECK_EQ(b.normal_count, k.nnormals);
-  CHECK_EQ(b.component_count, k.ncomp);
-  CHECK_EQ(k.ntri, a.triangle_count);
-  CHECK_EQ(k.nnormals, n);
-  CHECK_EQ(k.ncomp, a.component_count);
+  EXPECT_MSG(k.chunks > a.triangle_count / 338, "%u chunks for %llu triangles",
+             k.chunks, (unsigned long long)a.triangle_count);
+  EXPECT_MSG(b.triangles == NULL && b.normals == NULL && b.genus == NULL,
+             "a job with a chunk callback kept its mesh");
+  EXPECT_EQ(b.triangle_count, k.ntri);
+  EXPECT_EQ(b.normal_count, k.nnormals);
+  EXPECT_EQ(b.component_count, k.ncomp);
+  EXPECT_EQ(k.ntri, a.triangle_count);
+  EXPECT_EQ(k.nnormals, n);
+  EXPECT_EQ(k.ncomp, a.component_count);
   /* The same daemon, the same points: the same mesh either way, as a set
    * of triangles (their order may differ from run to run). */
-  sc_meshcheck_t mc;
-  REQUIRE(sc_meshcheck((size_t)n, xyz, k.tri, (size_t)k.ntri, NULL, &mc) ==
-              SC_TS_OK,
-          "mesh check");
+  scs_meshcheck_t mc;
+  ASSERT_MSG(scs_meshcheck((size_t)n, xyz, k.tri, (size_t)k.ntri, NULL, &mc) ==
+                 SCS_OK,
+             "mesh check");
   char why[256] = "";
-  CHECK(sc_meshcheck_expect(&mc, SC_SURF_GENUS2, SC_EXPECT_OUTWARD, why,
-                            sizeof why),
-        "chunked mesh: %s", why);
-  sc_meshcheck_free(&mc);
-  CHECK(k.genus && a.genus &&
-            memcmp(k.genus, a.genus, (size_t)k.ncomp * sizeof(int32_t)) == 0,
-        "genera differ");
+  EXPECT_MSG(scs_meshcheck_expect(&mc, SCS_SURF_GENUS2, SCS_EXPECT_OUTWARD, why,
+                                  sizeof why),
+             "chunked mesh: %s", why);
+  scs_meshcheck_free(&mc);
+  EXPECT_MSG(k.genus && a.genus &&
+                 memcmp(k.genus, a.genus, (size_t)k.ncomp * sizeof(int32_t)) ==
+                     0,
+             "genera differ");
   free(k.tri);
   free(k.normals);
   free(k.genus);
@@ -198,9 +200,9 @@ static void chunks(void) {
 int main(int argc, char **argv) {
   scdt_init(argc, argv);
   const char *args[] = {"--workers", "2", NULL};
-  REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
+  ASSERT_MSG(scdt_daemon_start(&d, args) == 0, "daemon did not start");
   progress();
   chunks();
-  CHECK_EQ(scdt_daemon_stop(&d), 0);
+  EXPECT_EQ(scdt_daemon_stop(&d), 0);
   return scdt_finish();
 }

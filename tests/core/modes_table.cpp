@@ -42,7 +42,7 @@
 
 #include "files.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 namespace {
 
@@ -129,8 +129,8 @@ void row(const char *file, const char *method, const char *path,
          size_t points, const uint32_t *t, size_t nt, const double *xyz,
          const Reference *ref, double spacing, double seconds,
          double dt_seconds) {
-  sc_meshcheck_t c;
-  if (sc_meshcheck(points, xyz, t, nt, nullptr, &c) != 0) {
+  scs_meshcheck_t c;
+  if (scs_meshcheck(points, xyz, t, nt, nullptr, &c) != 0) {
     std::printf("| %s | %s | meshcheck failed |\n", file, method);
     return;
   }
@@ -160,7 +160,7 @@ void row(const char *file, const char *method, const char *path,
               genus, dist, seconds,
               seconds / dt_seconds);
   std::fflush(stdout);
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
 }
 
 // Measures one file and prints its rows; 0 on success.

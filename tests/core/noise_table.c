@@ -20,9 +20,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define PI 3.14159265358979323846
 
@@ -35,8 +36,15 @@ static const char *const mode_names[] = {"cocone", "shortcrust", "watertight",
 #define MODE_COUNT (sizeof modes / sizeof modes[0])
 
 /* A standard normal deviate (Box-Muller). */
-static double gauss(sc_rng_t *rng) {
-  double u = sc_rng_uniform(rng), v = sc_rng_uniform(rng);
+/* Wall-clock seconds, for the time column. */
+static double seconds_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double gauss(scs_rng_t *rng) {
+  double u = scs_rng_uniform(rng), v = scs_rng_uniform(rng);
   if (u < 1e-300)
     u = 1e-300;
   return sqrt(-2 * log(u)) * cos(2 * PI * v);
@@ -57,7 +65,7 @@ static void usage(FILE *f, const char *argv0) {
 int main(int argc, char **argv) {
   size_t n = 20000;
   int seeds = 3;
-  int surfaces[SC_SURF_COUNT], ns = 0;
+  int surfaces[SCS_SURF_COUNT], ns = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--help") == 0) {
       usage(stdout, argv[0]);
@@ -85,12 +93,12 @@ int main(int argc, char **argv) {
       }
       seeds = (int)k;
     } else if (strcmp(argv[i - 1], "--surface") == 0) {
-      int s = sc_surface_from_name(v);
+      int s = scs_surface_from_name(v);
       if (s < 0) {
         fprintf(stderr, "%s: --surface: unknown surface '%s'\n", argv[0], v);
         return 2;
       }
-      if (ns < SC_SURF_COUNT)
+      if (ns < SCS_SURF_COUNT)
         surfaces[ns++] = s;
     } else {
       fprintf(stderr, "%s: unknown option '%s'\n", argv[0], argv[i - 1]);
@@ -99,9 +107,9 @@ int main(int argc, char **argv) {
     }
   }
   if (ns == 0) {
-    surfaces[ns++] = SC_SURF_SPHERE;
-    surfaces[ns++] = SC_SURF_TORUS;
-    surfaces[ns++] = SC_SURF_GENUS2;
+    surfaces[ns++] = SCS_SURF_SPHERE;
+    surfaces[ns++] = SCS_SURF_TORUS;
+    surfaces[ns++] = SCS_SURF_GENUS2;
   }
 
   double *clean = malloc(3 * n * sizeof *clean);
@@ -112,14 +120,14 @@ int main(int argc, char **argv) {
   }
   /* The largest level at which every seed was right, per surface and mode;
    * -1 when even the clean sample was not. */
-  double limit[SC_SURF_COUNT][MODE_COUNT];
+  double limit[SCS_SURF_COUNT][MODE_COUNT];
   printf("| surface | noise (sigma / spacing) | mode | right | closed | "
          "genus (expected) | components | samples unused, worst | time, "
          "mean |\n|---|--:|---|--:|--:|---|--:|--:|--:|\n");
   for (int si = 0; si < ns; ++si) {
     const int s = surfaces[si];
-    const sc_surface_info_t *info = sc_surface_info((sc_surface_t)s);
-    const double spacing = sc_surface_spacing((sc_surface_t)s, n);
+    const scs_surface_info_t *info = scs_surface_info((scs_surface_t)s);
+    const double spacing = scs_surface_spacing((scs_surface_t)s, n);
     int failed[MODE_COUNT] = {0};
     for (size_t m = 0; m < MODE_COUNT; ++m)
       limit[s][m] = -1;
@@ -130,13 +138,13 @@ int main(int argc, char **argv) {
         uint64_t comps_lo = UINT64_MAX, comps_hi = 0, unused = 0;
         double seconds = 0;
         for (int k = 0; k < seeds; ++k) {
-          if (sc_sample_surface((sc_surface_t)s, SC_DENSITY_UNIFORM, n,
-                                (uint64_t)k + 1, clean) != 0) {
+          if (scs_sample_surface((scs_surface_t)s, SCS_DENSITY_UNIFORM, n,
+                                 (uint64_t)k + 1, clean) != 0) {
             fprintf(stderr, "%s: sampling failed\n", argv[0]);
             return 1;
           }
-          sc_rng_t rng;
-          sc_rng_seed(&rng, 1000 + (uint64_t)k);
+          scs_rng_t rng;
+          scs_rng_seed(&rng, 1000 + (uint64_t)k);
           const double sigma = levels[l] * spacing;
           for (size_t i = 0; i < 3 * n; ++i)
             xyz[i] = clean[i] + sigma * gauss(&rng);
@@ -145,17 +153,17 @@ int main(int argc, char **argv) {
           p.mode = (sc_mode_t)modes[m];
           sc_mesh_t *mesh = NULL;
           char msg[256];
-          double t0 = sc_ts_seconds();
+          double t0 = seconds_now();
           int rc = sc_reconstruct(xyz, n, &p, &mesh, msg, sizeof msg);
-          seconds += sc_ts_seconds() - t0;
+          seconds += seconds_now() - t0;
           if (rc != 0) {
             fprintf(stderr, "%s %g %s: %s\n", info->name, levels[l],
                     mode_names[m], msg);
             continue;
           }
-          sc_meshcheck_t c;
-          if (sc_meshcheck(n, xyz, mesh->triangles, mesh->triangle_count,
-                           NULL, &c) != 0) {
+          scs_meshcheck_t c;
+          if (scs_meshcheck(n, xyz, mesh->triangles, mesh->triangle_count, NULL,
+                            &c) != 0) {
             sc_mesh_free(mesh);
             continue;
           }
@@ -168,7 +176,7 @@ int main(int argc, char **argv) {
           right += c.manifold && c.closed && c.oriented &&
                    c.components == (uint64_t)info->components &&
                    c.genus_total == info->genus_total;
-          sc_meshcheck_free(&c);
+          scs_meshcheck_free(&c);
           sc_mesh_free(mesh);
         }
         if (right == seeds && !failed[m])
@@ -205,7 +213,7 @@ int main(int argc, char **argv) {
   printf("\n");
   for (int si = 0; si < ns; ++si) {
     const int s = surfaces[si];
-    printf("| %s |", sc_surface_name((sc_surface_t)s));
+    printf("| %s |", scs_surface_name((scs_surface_t)s));
     for (size_t m = 0; m < MODE_COUNT; ++m) {
       if (limit[s][m] < 0)
         printf(" none |");

@@ -5,12 +5,13 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "check.h"
+#include "sct_assert.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 enum { N = 6000 };
 
@@ -91,17 +92,17 @@ int main(void) {
                        SC_ECANCELLED,        SC_ETOO_MANY_POINTS,
                        SC_EINTERNAL,         SC_EBAD_STATE};
   for (size_t i = 0; i < sizeof codes / sizeof codes[0]; ++i) {
-    CHECK(codes[i] < 0);
-    CHECK(strcmp(sc_err_name(codes[i]), "UNKNOWN") != 0);
-    CHECK(strcmp(sc_strerror(codes[i]), "unknown error") != 0);
+    EXPECT_LT(codes[i], 0);
+    EXPECT_STR_NE(sc_err_name(codes[i]), "UNKNOWN");
+    EXPECT_STR_NE(sc_strerror(codes[i]), "unknown error");
     for (size_t j = 0; j < i; ++j)
-      CHECK(strcmp(sc_err_name(codes[i]), sc_err_name(codes[j])) != 0);
+      EXPECT_STR_NE(sc_err_name(codes[i]), sc_err_name(codes[j]));
   }
-  CHECK(strcmp(sc_err_name(-999), "UNKNOWN") == 0);
-  CHECK(strcmp(sc_strerror(-999), "unknown error") == 0);
-  CHECK(strcmp(sc_stage_name(SC_STAGE_DELAUNAY), "delaunay") == 0);
-  CHECK(strcmp(sc_stage_name(SC_STAGE_COUNT), "?") == 0);
-  CHECK(sc_estimate_bytes(2000000) > sc_estimate_bytes(1000000));
+  EXPECT_STR_EQ(sc_err_name(-999), "UNKNOWN");
+  EXPECT_STR_EQ(sc_strerror(-999), "unknown error");
+  EXPECT_STR_EQ(sc_stage_name(SC_STAGE_DELAUNAY), "delaunay");
+  EXPECT_STR_EQ(sc_stage_name(SC_STAGE_COUNT), "?");
+  EXPECT_GT(sc_estimate_bytes(2000000), sc_estimate_bytes(1000000));
 
   /* sc_params_check() takes the defaults and says what is out of range,
    * as sc_reconstruct() would. */
@@ -109,30 +110,29 @@ int main(void) {
     sc_params_t q;
     char why[256] = "";
     sc_params_init(&q);
-    CHECK_EQ_INT(sc_params_check(&q, why, sizeof why), SC_OK);
+    EXPECT_EQ(sc_params_check(&q, why, sizeof why), SC_OK);
     q.boundary_rho = 11;
-    CHECK_EQ_INT(sc_params_check(&q, why, sizeof why), SC_EINVALID_ARGUMENT);
-    CHECK(strstr(why, "boundary_rho") != NULL);
+    EXPECT_EQ(sc_params_check(&q, why, sizeof why), SC_EINVALID_ARGUMENT);
+    EXPECT_STR_CONTAINS(why, "boundary_rho");
     sc_params_init(&q);
     q.max_hole_edges = -1;
-    CHECK_EQ_INT(sc_params_check(&q, NULL, 0), SC_EINVALID_ARGUMENT);
-    CHECK_EQ_INT(sc_params_check(NULL, why, sizeof why),
-                 SC_EINVALID_ARGUMENT);
+    EXPECT_EQ(sc_params_check(&q, NULL, 0), SC_EINVALID_ARGUMENT);
+    EXPECT_EQ(sc_params_check(NULL, why, sizeof why), SC_EINVALID_ARGUMENT);
   }
 
   double *xyz = malloc(3 * N * sizeof *xyz);
-  sc_sample_surface(SC_SURF_TORUS, SC_DENSITY_UNIFORM, N, 11, xyz);
+  scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, N, 11, xyz);
   sc_params_t p;
   sc_params_init(&p);
   char msg[256];
 
   sc_mesh_t *ref = NULL;
-  CHECK_EQ_INT(sc_reconstruct(xyz, N, &p, &ref, msg, sizeof msg), 0);
+  EXPECT_EQ(sc_reconstruct(xyz, N, &p, &ref, msg, sizeof msg), 0);
   if (!ref)
-    return CHECK_DONE();
-  CHECK(ref->diag.closed && ref->diag.genus == 1);
-  CHECK_EQ_INT(ref->point_count, N);
-  CHECK(in_canonical_order(ref));
+    return sct_finish("core_api");
+  EXPECT(ref->diag.closed && ref->diag.genus == 1);
+  EXPECT_EQ(ref->point_count, N);
+  EXPECT(in_canonical_order(ref));
   /* The order holds in every mode, and for a sample of fewer points than
    * the ranges the sort first splits the vertex numbers into. */
   {
@@ -145,31 +145,30 @@ int main(void) {
         sc_params_t q = p;
         q.mode = modes[k];
         sc_mesh_t *m = NULL;
-        CHECK_EQ_INT(sc_reconstruct(xyz, counts[c], &q, &m, msg, sizeof msg),
-                     0);
-        CHECK(m && m->triangle_count > 0 && in_canonical_order(m));
+        EXPECT_EQ(sc_reconstruct(xyz, counts[c], &q, &m, msg, sizeof msg), 0);
+        EXPECT(m && m->triangle_count > 0 && in_canonical_order(m));
         sc_mesh_free(m);
       }
   }
 
   /* Streaming in uneven chunks gives the same surface. */
   sc_recon_t *r = NULL;
-  CHECK_EQ_INT(sc_recon_new(&p, &r), 0);
+  EXPECT_EQ(sc_recon_new(&p, &r), 0);
   for (size_t at = 0; at < N;) {
     size_t k = at == 0 ? 3 : 977; /* a first chunk too small to triangulate */
     if (k > N - at)
       k = N - at;
-    CHECK_EQ_INT(sc_recon_add(r, xyz + 3 * at, k, msg, sizeof msg), 0);
+    EXPECT_EQ(sc_recon_add(r, xyz + 3 * at, k, msg, sizeof msg), 0);
     at += k;
   }
   sc_mesh_t *streamed = NULL;
-  CHECK_EQ_INT(sc_recon_finish(r, &streamed, msg, sizeof msg), 0);
-  CHECK(streamed && same_surface(ref, streamed));
+  EXPECT_EQ(sc_recon_finish(r, &streamed, msg, sizeof msg), 0);
+  EXPECT(streamed && same_surface(ref, streamed));
   /* A finished reconstruction takes nothing more. */
   sc_mesh_t *again = NULL;
-  CHECK_EQ_INT(sc_recon_add(r, xyz, 1, msg, sizeof msg), SC_EBAD_STATE);
-  CHECK_EQ_INT(sc_recon_finish(r, &again, msg, sizeof msg), SC_EBAD_STATE);
-  CHECK(again == NULL);
+  EXPECT_EQ(sc_recon_add(r, xyz, 1, msg, sizeof msg), SC_EBAD_STATE);
+  EXPECT_EQ(sc_recon_finish(r, &again, msg, sizeof msg), SC_EBAD_STATE);
+  EXPECT_NULL(again);
   sc_recon_free(r);
   sc_mesh_free(streamed);
   sc_recon_free(NULL);
@@ -200,21 +199,21 @@ int main(void) {
       sc_params_t q = p;
       q.mode = gm[k];
       sc_mesh_t *one = NULL, *chunked = NULL;
-      CHECK_EQ_INT(sc_reconstruct(grid, ng, &q, &one, msg, sizeof msg), 0);
-      CHECK_EQ_INT(sc_recon_new(&q, &r), 0);
+      EXPECT_EQ(sc_reconstruct(grid, ng, &q, &one, msg, sizeof msg), 0);
+      EXPECT_EQ(sc_recon_new(&q, &r), 0);
       for (size_t at = 0; at < ng; at += 500)
-        CHECK_EQ_INT(sc_recon_add(r, grid + 3 * at, ng - at < 500 ? ng - at : 500,
-                                  msg, sizeof msg),
-                     0);
-      CHECK_EQ_INT(sc_recon_finish(r, &chunked, msg, sizeof msg), 0);
+        EXPECT_EQ(sc_recon_add(r, grid + 3 * at, ng - at < 500 ? ng - at : 500,
+                               msg, sizeof msg),
+                  0);
+      EXPECT_EQ(sc_recon_finish(r, &chunked, msg, sizeof msg), 0);
       sc_recon_free(r);
-      CHECK(one && chunked && one->triangle_count > 0 &&
-            one->triangle_count == chunked->triangle_count &&
-            memcmp(one->triangles, chunked->triangles,
-                   3 * one->triangle_count * sizeof *one->triangles) == 0);
-      CHECK(one && chunked && one->normals && chunked->normals &&
-            memcmp(one->normals, chunked->normals,
-                   3 * ng * sizeof *one->normals) == 0);
+      EXPECT(one && chunked && one->triangle_count > 0 &&
+             one->triangle_count == chunked->triangle_count &&
+             memcmp(one->triangles, chunked->triangles,
+                    3 * one->triangle_count * sizeof *one->triangles) == 0);
+      EXPECT(one && chunked && one->normals && chunked->normals &&
+             memcmp(one->normals, chunked->normals,
+                    3 * ng * sizeof *one->normals) == 0);
       sc_mesh_free(one);
       sc_mesh_free(chunked);
     }
@@ -222,24 +221,24 @@ int main(void) {
   }
 
   /* A failed add leaves only free() allowed. */
-  CHECK_EQ_INT(sc_recon_new(&p, &r), 0);
+  EXPECT_EQ(sc_recon_new(&p, &r), 0);
   double nan_pt[3] = {0, 0, 0};
   nan_pt[1] = 0.0 / 0.0;
-  CHECK_EQ_INT(sc_recon_add(r, nan_pt, 1, msg, sizeof msg), SC_ENONFINITE);
-  CHECK_EQ_INT(sc_recon_add(r, xyz, N, msg, sizeof msg), SC_EBAD_STATE);
+  EXPECT_EQ(sc_recon_add(r, nan_pt, 1, msg, sizeof msg), SC_ENONFINITE);
+  EXPECT_EQ(sc_recon_add(r, xyz, N, msg, sizeof msg), SC_EBAD_STATE);
   sc_recon_free(r);
   sc_params_t bad = p;
   bad.r = 2;
   r = (sc_recon_t *)&r;
-  CHECK_EQ_INT(sc_recon_new(&bad, &r), SC_EINVALID_ARGUMENT);
-  CHECK(r == NULL);
+  EXPECT_EQ(sc_recon_new(&bad, &r), SC_EINVALID_ARGUMENT);
+  EXPECT_NULL(r);
 
   /* The parallel triangulation gives the same surface. */
   sc_params_t par = p;
   par.threads = 2;
   sc_mesh_t *pm = NULL;
-  CHECK_EQ_INT(sc_reconstruct(xyz, N, &par, &pm, msg, sizeof msg), 0);
-  CHECK(pm && same_surface(ref, pm));
+  EXPECT_EQ(sc_reconstruct(xyz, N, &par, &pm, msg, sizeof msg), 0);
+  EXPECT(pm && same_surface(ref, pm));
   sc_mesh_free(pm);
 
   /* Progress visits the stages in order with fractions in [0, 1]. */
@@ -247,10 +246,10 @@ int main(void) {
   p.progress = on_progress;
   p.progress_user = &pr;
   sc_mesh_t *m = NULL;
-  CHECK_EQ_INT(sc_reconstruct(xyz, N, &p, &m, msg, sizeof msg), 0);
-  CHECK(pr.calls > SC_STAGE_COUNT);
-  CHECK(!pr.regress);
-  CHECK_EQ_INT(pr.last_stage, SC_STAGE_EXTRACT);
+  EXPECT_EQ(sc_reconstruct(xyz, N, &p, &m, msg, sizeof msg), 0);
+  EXPECT_GT(pr.calls, SC_STAGE_COUNT);
+  EXPECT(!pr.regress);
+  EXPECT_EQ(pr.last_stage, SC_STAGE_EXTRACT);
   sc_mesh_free(m);
 
   /* Cancelling in any stage stops the run with CANCELLED and no mesh. */
@@ -260,9 +259,9 @@ int main(void) {
     int rc = sc_reconstruct(xyz, N, &p, &m, msg, sizeof msg);
     if (rc != SC_ECANCELLED)
       fprintf(stderr, "cancel in stage %s: got %d\n", sc_stage_name(s), rc);
-    CHECK_EQ_INT(rc, SC_ECANCELLED);
-    CHECK(m == NULL);
-    CHECK_EQ_INT(pr.last_stage, s);
+    EXPECT_EQ(rc, SC_ECANCELLED);
+    EXPECT_NULL(m);
+    EXPECT_EQ(pr.last_stage, s);
   }
 
   /* The allocator hint is taken by glibc's own malloc (the sanitizers
@@ -270,17 +269,17 @@ int main(void) {
   int tuned = sc_tune_allocator();
 #if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) &&                    \
     !defined(__SANITIZE_THREAD__)
-  CHECK_EQ_INT(tuned, SC_OK);
+  EXPECT_EQ(tuned, SC_OK);
 #else
-  CHECK(tuned == SC_OK || tuned == SC_EINTERNAL);
+  EXPECT(tuned == SC_OK || tuned == SC_EINTERNAL);
 #endif
   sc_params_init(&p);
   sc_mesh_t *tuned_mesh = NULL;
-  CHECK_EQ_INT(sc_reconstruct(xyz, N, &p, &tuned_mesh, msg, sizeof msg), 0);
-  CHECK(tuned_mesh && same_surface(ref, tuned_mesh));
+  EXPECT_EQ(sc_reconstruct(xyz, N, &p, &tuned_mesh, msg, sizeof msg), 0);
+  EXPECT(tuned_mesh && same_surface(ref, tuned_mesh));
   sc_mesh_free(tuned_mesh);
 
   sc_mesh_free(ref);
   free(xyz);
-  return CHECK_DONE();
+  return sct_finish("core_api");
 }

@@ -6,12 +6,13 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "check.h"
+#include "sct_assert.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 /* Runs a reconstruction that must fail with `want`, leaving no mesh and a
  * message. */
@@ -21,14 +22,13 @@ static void expect_error(const char *what, const double *xyz, size_t n,
   char msg[256] = "";
   int rc = sc_reconstruct(xyz, n, params, &mesh, msg, sizeof msg);
   if (rc != want) {
-    fprintf(stderr, "FAIL: %s: got %d (%s: %s), expected %d (%s)\n", what, rc,
-            sc_err_name(rc), msg, want, sc_err_name(want));
-    ++check_failures;
+    EXPECT_FAIL("%s: got %d (%s: %s), expected %d (%s)", what, rc,
+                sc_err_name(rc), msg, want, sc_err_name(want));
   } else {
     printf("ok: %s -> %s: %s\n", what, sc_err_name(rc), msg);
   }
-  CHECK(mesh == NULL);
-  CHECK(msg[0] != '\0');
+  EXPECT_NULL(mesh);
+  EXPECT_NE(msg[0], '\0');
   if (rc == 0)
     sc_mesh_free(mesh);
 }
@@ -68,7 +68,7 @@ int main(void) {
   expect_error("4 points, 3 distinct", dup4, 4, &p, SC_EDEGENERATE_INPUT);
 
   /* Non-finite coordinates anywhere. */
-  sc_sample_surface(SC_SURF_SPHERE, SC_DENSITY_UNIFORM_RANDOM, 400, 3, pts);
+  scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM_RANDOM, 400, 3, pts);
   const double bad[] = {NAN, INFINITY, -INFINITY};
   for (int b = 0; b < 3; ++b)
     for (int where = 0; where < 3; ++where) {
@@ -81,8 +81,7 @@ int main(void) {
 
   /* Invalid arguments and parameters. */
   expect_error("NULL points", NULL, 10, &p, SC_EINVALID_ARGUMENT);
-  CHECK_EQ_INT(sc_reconstruct(pts, 400, &p, NULL, NULL, 0),
-               SC_EINVALID_ARGUMENT);
+  EXPECT_EQ(sc_reconstruct(pts, 400, &p, NULL, NULL, 0), SC_EINVALID_ARGUMENT);
   sc_params_t q;
   q = p, q.r = 0;
   expect_error("r = 0", pts, 400, &q, SC_EINVALID_ARGUMENT);
@@ -110,15 +109,15 @@ int main(void) {
   sc_mesh_t *mesh = NULL;
   char msg[256] = "";
   int rc = sc_reconstruct(four, 4, &p, &mesh, msg, sizeof msg);
-  CHECK_EQ_INT(rc, 0);
+  EXPECT_EQ(rc, 0);
   if (rc == 0) {
-    sc_meshcheck_t c;
-    CHECK_EQ_INT(sc_meshcheck(4, four, mesh->triangles, mesh->triangle_count,
-                              NULL, &c),
-                 0);
-    CHECK(c.manifold && c.oriented);
-    CHECK(mesh->triangle_count == 0 || (c.closed && c.volume > 0));
-    sc_meshcheck_free(&c);
+    scs_meshcheck_t c;
+    EXPECT_EQ(
+        scs_meshcheck(4, four, mesh->triangles, mesh->triangle_count, NULL, &c),
+        0);
+    EXPECT(c.manifold && c.oriented);
+    EXPECT(mesh->triangle_count == 0 || (c.closed && c.volume > 0));
+    scs_meshcheck_free(&c);
     sc_mesh_free(mesh);
   }
 
@@ -126,33 +125,33 @@ int main(void) {
    * normal; the rest of the sample is reconstructed as without them. */
   enum { N = 3000, D = 300 };
   double *xyz = malloc(3 * (N + D) * sizeof *xyz);
-  sc_sample_surface(SC_SURF_SPHERE, SC_DENSITY_UNIFORM, N, 5, xyz);
+  scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM, N, 5, xyz);
   for (int i = 0; i < D; ++i)
     memcpy(xyz + 3 * (N + i), xyz + 3 * (size_t)(7 * i), 3 * sizeof *xyz);
   rc = sc_reconstruct(xyz, N + D, &p, &mesh, msg, sizeof msg);
-  CHECK_EQ_INT(rc, 0);
+  EXPECT_EQ(rc, 0);
   if (rc == 0) {
-    CHECK_EQ_INT(mesh->diag.duplicates_merged, D);
-    CHECK_EQ_INT(mesh->diag.delaunay_vertices, N);
+    EXPECT_EQ(mesh->diag.duplicates_merged, D);
+    EXPECT_EQ(mesh->diag.delaunay_vertices, N);
     unsigned char *ignore = calloc(N + D, 1);
     memset(ignore + N, 1, D);
-    sc_meshcheck_t c;
-    sc_meshcheck(N + D, xyz, mesh->triangles, mesh->triangle_count, ignore,
-                 &c);
+    scs_meshcheck_t c;
+    scs_meshcheck(N + D, xyz, mesh->triangles, mesh->triangle_count, ignore,
+                  &c);
     char why[256];
-    CHECK(sc_meshcheck_expect(&c, SC_SURF_SPHERE,
-                              SC_EXPECT_ALL_USED | SC_EXPECT_OUTWARD, why,
-                              sizeof why));
+    EXPECT(scs_meshcheck_expect(&c, SCS_SURF_SPHERE,
+                                SCS_EXPECT_ALL_USED | SCS_EXPECT_OUTWARD, why,
+                                sizeof why));
     for (uint32_t t = 0; t < 3 * mesh->triangle_count; ++t)
-      CHECK(mesh->triangles[t] < N);
+      EXPECT_LT(mesh->triangles[t], N);
     for (int i = 0; i < D; ++i)
-      CHECK(memcmp(mesh->normals + 3 * (N + i),
-                   mesh->normals + 3 * (size_t)(7 * i),
-                   3 * sizeof(double)) == 0);
-    sc_meshcheck_free(&c);
+      EXPECT_EQ(memcmp(mesh->normals + 3 * (N + i),
+                       mesh->normals + 3 * (size_t)(7 * i), 3 * sizeof(double)),
+                0);
+    scs_meshcheck_free(&c);
     free(ignore);
     sc_mesh_free(mesh);
   }
   free(xyz);
-  return CHECK_DONE();
+  return sct_finish("core_degenerate");
 }

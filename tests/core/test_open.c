@@ -25,8 +25,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "check.h"
+#include "diag.h"
 #include "shortcrust.h"
+#include "synth.h"
 #include "testsupport.h"
 
 #define PI 3.14159265358979323846
@@ -83,8 +84,8 @@ static double dist3(const double *a, const double *b) {
 
 /* One area-uniform random point of surface s (the wavy disc is uniform in
  * the plane, which its gentle slope makes nearly uniform in area). */
-static void open_point(int s, sc_rng_t *rng, double p[3]) {
-  double u = sc_rng_uniform(rng), v = sc_rng_uniform(rng);
+static void open_point(int s, scs_rng_t *rng, double p[3]) {
+  double u = scs_rng_uniform(rng), v = scs_rng_uniform(rng);
   switch (s) {
   case HOLED_TORUS:
     /* The tube angle by rejection against the area element, then outside
@@ -93,10 +94,10 @@ static void open_point(int s, sc_rng_t *rng, double p[3]) {
       double t = 2 * PI * u, f = 2 * PI * v;
       double w = TOR_R + TOR_r * cos(f);
       p[0] = w * cos(t), p[1] = w * sin(t), p[2] = TOR_r * sin(f);
-      if (sc_rng_uniform(rng) * (TOR_R + TOR_r) <= w &&
+      if (scs_rng_uniform(rng) * (TOR_R + TOR_r) <= w &&
           dist3(p, HOLE_C) > HOLE_R)
         return;
-      u = sc_rng_uniform(rng), v = sc_rng_uniform(rng);
+      u = scs_rng_uniform(rng), v = scs_rng_uniform(rng);
     }
   case HEMISPHERE:
   case CUT_SPHERE: {
@@ -158,8 +159,8 @@ static size_t sample_open(int s, size_t n, uint64_t seed, double spacing,
   }
   for (size_t i = 0; i < (size_t)g * g * g; ++i)
     head[i] = -1;
-  sc_rng_t rng;
-  sc_rng_seed(&rng, seed);
+  scs_rng_t rng;
+  scs_rng_seed(&rng, seed);
   for (size_t tries = 0; tries < 40 * n && count < cap; ++tries) {
     double p[3];
     open_point(s, &rng, p);
@@ -272,53 +273,53 @@ int main(int argc, char **argv) {
   p.watertight_labels = labels;
   sc_mesh_t *m = NULL;
   char msg[256] = "";
-  double t0 = sc_ts_seconds();
+  double t0 = sct_seconds();
   int rc = sc_reconstruct(xyz, n, &p, &m, msg, sizeof msg);
-  double t1 = sc_ts_seconds();
-  CHECK_EQ_INT(rc, 0);
+  double t1 = sct_seconds();
+  EXPECT_EQ(rc, 0);
   if (rc != 0) {
     fprintf(stderr, "%s\n", msg);
     free(xyz);
-    return CHECK_DONE();
+    return sct_finish("core_open");
   }
-  sc_meshcheck_t c;
-  CHECK_EQ_INT(sc_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
-               0);
+  scs_meshcheck_t c;
+  EXPECT_EQ(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
+            0);
   char line[512];
   printf("%s %s n=%zu: %s path=%s boundary_samples=%llu holes=%llu/%llu "
          "handles_cut=%llu (%.2f s)\n",
-         argv[1], argv[2], n, sc_meshcheck_summary(&c, line, sizeof line),
+         argv[1], argv[2], n, scs_meshcheck_summary(&c, line, sizeof line),
          sc_path_name(m->diag.path),
          (unsigned long long)m->diag.boundary_samples,
          (unsigned long long)m->diag.holes_filled,
          (unsigned long long)m->diag.hole_triangles,
          (unsigned long long)m->diag.handles_cut, t1 - t0);
-  CHECK(c.manifold);
-  CHECK(c.oriented);
-  CHECK_EQ_INT(c.nonmanifold_edges, 0);
-  CHECK_EQ_INT(c.nonmanifold_vertices, 0);
-  CHECK_EQ_INT(c.components, 1);
-  CHECK_EQ_INT(m->diag.nonmanifold_edges, 0);
-  CHECK_EQ_INT(m->diag.nonmanifold_vertices, 0);
-  CHECK_EQ_INT(m->diag.boundary_loops, c.boundary_loops);
-  CHECK_DIAG_COUNTS(m->diag, c);
+  EXPECT(c.manifold);
+  EXPECT(c.oriented);
+  EXPECT_EQ(c.nonmanifold_edges, 0);
+  EXPECT_EQ(c.nonmanifold_vertices, 0);
+  EXPECT_EQ(c.components, 1);
+  EXPECT_EQ(m->diag.nonmanifold_edges, 0);
+  EXPECT_EQ(m->diag.nonmanifold_vertices, 0);
+  EXPECT_EQ(m->diag.boundary_loops, c.boundary_loops);
+  EXPECT_DIAG_COUNTS(m->diag, c);
 
   if (mode == SC_MODE_WATERTIGHT) {
-    CHECK(c.closed);
-    CHECK_EQ_INT(c.genus_total, closed_genus[s]);
-    CHECK(c.volume > 0);
-    CHECK(m->diag.closed);
-    CHECK(m->diag.path == SC_PATH_WATERTIGHT ||
-          m->diag.path == SC_PATH_WATERTIGHT_FILL);
+    EXPECT(c.closed);
+    EXPECT_EQ(c.genus_total, closed_genus[s]);
+    EXPECT_GT(c.volume, 0);
+    EXPECT(m->diag.closed);
+    EXPECT(m->diag.path == SC_PATH_WATERTIGHT ||
+           m->diag.path == SC_PATH_WATERTIGHT_FILL);
     if (labels)
-      CHECK_EQ_INT(m->diag.path, SC_PATH_WATERTIGHT);
+      EXPECT_EQ(m->diag.path, SC_PATH_WATERTIGHT);
     /* Closing may bury a sample or two of the rim inside. */
-    CHECK(c.samples_unused * 100 <= n);
+    EXPECT_LE(c.samples_unused * 100, n);
   } else {
-    CHECK_EQ_INT(c.boundary_loops, open_loops[s]);
-    CHECK_EQ_INT(m->diag.path, SC_PATH_BOUNDARY);
-    CHECK(m->diag.boundary_samples > 0);
-    CHECK(c.samples_unused * 200 <= n);
+    EXPECT_EQ(c.boundary_loops, open_loops[s]);
+    EXPECT_EQ(m->diag.path, SC_PATH_BOUNDARY);
+    EXPECT_GT(m->diag.boundary_samples, 0);
+    EXPECT_LE(c.samples_unused * 200, n);
     /* Every vertex of a boundary edge lies near the true boundary; and the
      * longest loop is at least as long as the shortest true curve needs. */
     unsigned char *on = malloc(n);
@@ -335,15 +336,15 @@ int main(int argc, char **argv) {
       }
       printf("boundary vertices: worst %.3g spacings from the true curve\n",
              worst / spacing);
-      CHECK_EQ_INT(far, 0);
+      EXPECT_EQ(far, 0);
       free(on);
     }
     /* The loops follow the boundary samples, which may be a few spacings
      * apart along the curve; but they are loops, not slivers. */
-    CHECK(m->diag.longest_loop >= 8);
+    EXPECT_GE(m->diag.longest_loop, 8);
   }
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
   sc_mesh_free(m);
   free(xyz);
-  return CHECK_DONE();
+  return sct_finish("core_open");
 }

@@ -8,13 +8,14 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "check.h"
+#include "diag.h"
 #include "files.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 int main(int argc, char **argv) {
   if (argc != 3 && argc != 4) {
@@ -42,32 +43,32 @@ int main(int argc, char **argv) {
   }
   sc_mesh_t *m = NULL;
   int rc = sc_reconstruct(pts.xyz, pts.count, &p, &m, msg, sizeof msg);
-  CHECK_EQ_INT(rc, 0);
+  EXPECT_EQ(rc, 0);
   if (rc != 0) {
     fprintf(stderr, "%s\n", msg);
-    return CHECK_DONE();
+    return sct_finish("core_realdata");
   }
-  sc_meshcheck_t c;
-  CHECK_EQ_INT(sc_meshcheck(pts.count, pts.xyz, m->triangles,
-                            m->triangle_count, NULL, &c),
-               0);
+  scs_meshcheck_t c;
+  EXPECT_EQ(scs_meshcheck(pts.count, pts.xyz, m->triangles, m->triangle_count,
+                          NULL, &c),
+            0);
   char line[512];
   printf("%s %s: %s; handles cut %llu\n", argv[1], argc == 4 ? argv[3] : "",
-         sc_meshcheck_summary(&c, line, sizeof line),
+         scs_meshcheck_summary(&c, line, sizeof line),
          (unsigned long long)m->diag.handles_cut);
-  CHECK(c.manifold);
-  CHECK(c.closed);
-  CHECK(c.oriented);
-  CHECK_EQ_INT(c.components, 1);
-  CHECK_EQ_INT(c.genus_total, genus);
-  CHECK(c.volume > 0);
+  EXPECT(c.manifold);
+  EXPECT(c.closed);
+  EXPECT(c.oriented);
+  EXPECT_EQ(c.components, 1);
+  EXPECT_EQ(c.genus_total, genus);
+  EXPECT_GT(c.volume, 0);
   /* A stray sample or two far from the surface may stay out. */
-  CHECK(c.samples_unused * 1000 <= pts.count);
-  CHECK_EQ_INT(m->diag.genus, genus);
-  CHECK(m->diag.closed);
-  CHECK_DIAG_COUNTS(m->diag, c);
-  sc_meshcheck_free(&c);
+  EXPECT_LE(c.samples_unused * 1000, pts.count);
+  EXPECT_EQ(m->diag.genus, genus);
+  EXPECT(m->diag.closed);
+  EXPECT_DIAG_COUNTS(m->diag, c);
+  scs_meshcheck_free(&c);
   sc_mesh_free(m);
   sc_points_free(&pts);
-  return CHECK_DONE();
+  return sct_finish("core_realdata");
 }

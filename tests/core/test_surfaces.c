@@ -14,7 +14,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sct_assert.h"
 #include "shortcrust.h"
+#include "synth.h"
 #include "testsupport.h"
 
 static int mode_from_name(const char *s) {
@@ -36,8 +38,8 @@ int main(int argc, char **argv) {
     fprintf(stderr, "usage: %s SURFACE DENSITY MODE N [SEED [R]]\n", argv[0]);
     return 2;
   }
-  int surf = sc_surface_from_name(argv[1]);
-  int dens = sc_density_from_name(argv[2]);
+  int surf = scs_surface_from_name(argv[1]);
+  int dens = scs_density_from_name(argv[2]);
   int mode = mode_from_name(argv[3]);
   size_t n = strtoul(argv[4], NULL, 10);
   uint64_t seed = argc > 5 ? strtoull(argv[5], NULL, 10) : 1;
@@ -47,7 +49,7 @@ int main(int argc, char **argv) {
   }
 
   double *xyz = malloc(3 * n * sizeof *xyz);
-  if (!xyz || sc_sample_surface(surf, dens, n, seed, xyz) != 0) {
+  if (!xyz || scs_sample_surface(surf, dens, n, seed, xyz) != 0) {
     fprintf(stderr, "sampling failed\n");
     return 1;
   }
@@ -58,40 +60,36 @@ int main(int argc, char **argv) {
     params.r = strtod(argv[6], NULL);
   sc_mesh_t *mesh = NULL;
   char msg[256] = "";
-  double t0 = sc_ts_seconds();
+  double t0 = sct_seconds();
   int rc = sc_reconstruct(xyz, n, &params, &mesh, msg, sizeof msg);
-  double t1 = sc_ts_seconds();
+  double t1 = sct_seconds();
   if (rc != 0) {
-    fprintf(stderr, "FAIL: sc_reconstruct returned %d (%s): %s\n", rc,
-            sc_err_name(rc), msg);
+    EXPECT_FAIL("sc_reconstruct returned %d (%s): %s", rc, sc_err_name(rc),
+                msg);
     return 1;
   }
 
-  int failures = 0;
-  sc_meshcheck_t c;
-  if (sc_meshcheck(n, xyz, mesh->triangles, mesh->triangle_count, NULL, &c)) {
+  scs_meshcheck_t c;
+  if (scs_meshcheck(n, xyz, mesh->triangles, mesh->triangle_count, NULL, &c)) {
     fprintf(stderr, "meshcheck failed\n");
     return 1;
   }
   char line[512];
   printf("%s %s %s n=%zu: %s (%.2f s)\n", argv[1], argv[2], argv[3], n,
-         sc_meshcheck_summary(&c, line, sizeof line), t1 - t0);
+         scs_meshcheck_summary(&c, line, sizeof line), t1 - t0);
   char why[256];
   /* The modes for scans may leave out a sample or two where the boundary
    * detection sees undersampling (at most one in a thousand). */
   const int scan_mode = mode == SC_MODE_BOUNDARY ||
                         mode == SC_MODE_WATERTIGHT || mode == SC_MODE_AUTO;
-  if (!sc_meshcheck_expect(&c, surf,
-                           (scan_mode ? 0u : SC_EXPECT_ALL_USED) |
-                               SC_EXPECT_OUTWARD,
-                           why, sizeof why)) {
-    fprintf(stderr, "FAIL: %s\n", why);
-    ++failures;
+  if (!scs_meshcheck_expect(
+          &c, surf, (scan_mode ? 0u : SCS_EXPECT_ALL_USED) | SCS_EXPECT_OUTWARD,
+          why, sizeof why)) {
+    EXPECT_FAIL("%s", why);
   }
   if (scan_mode && c.samples_unused * 1000 > n) {
-    fprintf(stderr, "FAIL: %llu of %zu samples unused\n",
-            (unsigned long long)c.samples_unused, n);
-    ++failures;
+    EXPECT_FAIL("%llu of %zu samples unused",
+                (unsigned long long)c.samples_unused, n);
   }
 
   /* The core's own diagnostics must agree with the independent checker. */
@@ -102,29 +100,26 @@ int main(int argc, char **argv) {
       d->boundary_edges != c.boundary_edges ||
       d->nonmanifold_edges != c.nonmanifold_edges ||
       d->nonmanifold_vertices != c.nonmanifold_vertices) {
-    fprintf(stderr,
-            "FAIL: diagnostics disagree with the checker: triangles %llu/%llu "
-            "components %llu/%llu closed %d/%d genus %lld/%lld unused "
-            "%llu/%llu boundary %llu/%llu\n",
-            (unsigned long long)d->triangles, (unsigned long long)c.faces,
-            (unsigned long long)d->components,
-            (unsigned long long)c.components, d->closed, c.closed,
-            (long long)d->genus, (long long)c.genus_total,
-            (unsigned long long)d->samples_unused,
-            (unsigned long long)c.samples_unused,
-            (unsigned long long)d->boundary_edges,
-            (unsigned long long)c.boundary_edges);
-    ++failures;
+    EXPECT_FAIL("diagnostics disagree with the checker: triangles %llu/%llu "
+                "components %llu/%llu closed %d/%d genus %lld/%lld unused "
+                "%llu/%llu boundary %llu/%llu",
+                (unsigned long long)d->triangles, (unsigned long long)c.faces,
+                (unsigned long long)d->components,
+                (unsigned long long)c.components, d->closed, c.closed,
+                (long long)d->genus, (long long)c.genus_total,
+                (unsigned long long)d->samples_unused,
+                (unsigned long long)c.samples_unused,
+                (unsigned long long)d->boundary_edges,
+                (unsigned long long)c.boundary_edges);
   }
 
   /* Vertices are samples, so they lie on the surface to rounding error. */
-  sc_distcheck_t dc;
-  if (sc_mesh_distance_check(surf, n, xyz, mesh->triangles,
-                             mesh->triangle_count, 1e-9, &dc) != 0 ||
+  scs_distcheck_t dc;
+  if (scs_mesh_distance_check(surf, n, xyz, mesh->triangles,
+                              mesh->triangle_count, 1e-9, &dc) != 0 ||
       dc.beyond != 0) {
-    fprintf(stderr, "FAIL: %llu vertices off the surface (max %g)\n",
-            (unsigned long long)dc.beyond, dc.max_distance);
-    ++failures;
+    EXPECT_FAIL("%llu vertices off the surface (max %g)",
+                (unsigned long long)dc.beyond, dc.max_distance);
   }
 
   /* Normals: unit length, and pointing outward like the true normal. */
@@ -133,15 +128,13 @@ int main(int argc, char **argv) {
     const double *nv = mesh->normals + 3 * i;
     double len = sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
     double truth[3];
-    sc_surface_normal(surf, xyz + 3 * i, truth);
+    scs_surface_normal(surf, xyz + 3 * i, truth);
     double dot = nv[0] * truth[0] + nv[1] * truth[1] + nv[2] * truth[2];
     if (fabs(len - 1) > 1e-9 || dot < 0.5)
       ++bad_normals;
   }
   if (bad_normals > n / 1000) {
-    fprintf(stderr, "FAIL: %zu of %zu normals not unit or not outward\n",
-            bad_normals, n);
-    ++failures;
+    EXPECT_FAIL("%zu of %zu normals not unit or not outward", bad_normals, n);
   }
 
   /* Every component's genus as reported per component. */
@@ -149,13 +142,12 @@ int main(int argc, char **argv) {
   for (size_t i = 0; i < mesh->component_count; ++i)
     sum += mesh->component_genus[i];
   if (mesh->component_count != c.components || sum != c.genus_total) {
-    fprintf(stderr, "FAIL: component_genus lists %zu components, sum %lld\n",
-            mesh->component_count, (long long)sum);
-    ++failures;
+    EXPECT_FAIL("component_genus lists %zu components, sum %lld",
+                mesh->component_count, (long long)sum);
   }
 
-  sc_meshcheck_free(&c);
+  scs_meshcheck_free(&c);
   sc_mesh_free(mesh);
   free(xyz);
-  return failures ? 1 : 0;
+  return sct_finish("core_surfaces");
 }

@@ -25,7 +25,7 @@
 
 #include "harness.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 600000
 
@@ -109,7 +109,7 @@ static double one_job(const char *sock, const double *xyz, size_t n,
   if (rc != 0 || !j.done) {
     fprintf(stderr, "job failed: %s %s\n", why, j.error_msg);
     t = -1;
-  } else if (!scdt_mesh_ok(SC_SURF_SPHERE, &j, why, sizeof why)) {
+  } else if (!scdt_mesh_ok(SCS_SURF_SPHERE, &j, why, sizeof why)) {
     fprintf(stderr, "wrong mesh: %s\n", why);
     t = -1;
   }
@@ -121,7 +121,7 @@ static double one_job(const char *sock, const double *xyz, size_t n,
 
 static void latency(size_t n, int repeat) {
   printf("latency: one job of %zu points\n", n);
-  double *xyz = scdt_sample(SC_SURF_SPHERE, n, 1);
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, n, 1);
   double *direct = calloc((size_t)repeat, sizeof *direct);
   double *daemon = calloc((size_t)repeat, sizeof *daemon);
   double *pair = calloc((size_t)repeat, sizeof *pair);
@@ -203,7 +203,7 @@ static void *burst_client(void *arg) {
   /* Checked after the clock stopped: the checks share the machine with the
    * daemon. */
   for (int k = 0; k < b->count; k++) {
-    if (!j[k].done || !scdt_mesh_ok(SC_SURF_SPHERE, &j[k], why, sizeof why))
+    if (!j[k].done || !scdt_mesh_ok(SCS_SURF_SPHERE, &j[k], why, sizeof why))
       atomic_fetch_add(b->failed, 1);
     scdt_job_reset(&j[k]);
   }
@@ -297,7 +297,7 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
   printf("throughput: %d jobs of %zu points over 4 connections\n", jobs, n);
   double **xyz = calloc((size_t)jobs, sizeof *xyz);
   for (int k = 0; k < jobs; k++)
-    xyz[k] = scdt_sample(SC_SURF_SPHERE, n, (uint64_t)k + 10);
+    xyz[k] = scdt_sample(SCS_SURF_SPHERE, n, (uint64_t)k + 10);
   double base = 0, direct_base = 0;
   double *t = calloc((size_t)repeat, sizeof *t);
   for (unsigned w = 1; w <= wmax; w++) {
@@ -317,7 +317,7 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
     /* A few small jobs first, one per worker: what a daemon keeps after
      * its first jobs (each thread's stack and malloc arena, libraries'
      * one-time state) is not the burst's. */
-    double *warm = scdt_sample(SC_SURF_SPHERE, 2000, 9);
+    double *warm = scdt_sample(SCS_SURF_SPHERE, 2000, 9);
     double **warms = calloc(w, sizeof *warms);
     for (unsigned i = 0; i < w; i++)
       warms[i] = warm;
@@ -429,8 +429,9 @@ int main(int argc, char **argv) {
     return 2;
   }
   char *fake[] = {argv[0], (char *)daemon, NULL};
-  scdt_init(2, fake);
+  scdt_setup(2, fake);
   latency(points, repeat);
   throughput(job_points, jobs, wmax, repeat);
-  return scdt_finish();
+  scdt_cleanup(0);
+  return 0;
 }

@@ -17,9 +17,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "testsupport.h"
-
-atomic_int scdt_failures;
+#include "synth.h"
 
 static const char *daemon_path;
 /* What scdt_finish() needs of every daemon, copied: tests keep their
@@ -32,7 +30,7 @@ static struct record {
 } records[SCDT_MAX_DAEMONS];
 static int nrecords;
 
-void scdt_init(int argc, char **argv) {
+void scdt_setup(int argc, char **argv) {
   signal(SIGPIPE, SIG_IGN);
   if (argc < 2) {
     fprintf(stderr, "usage: %s PATH-TO-SHORTCRUSTD\n", argv[0]);
@@ -79,8 +77,7 @@ static void remove_dir(const char *dir) {
   rmdir(dir);
 }
 
-int scdt_finish(void) {
-  int failed = atomic_load(&scdt_failures);
+void scdt_cleanup(int show_logs) {
   for (int i = 0; i < nrecords; i++) {
     struct record *r = &records[i];
     if (r->pid > 0) {
@@ -88,17 +85,12 @@ int scdt_finish(void) {
       waitpid(r->pid, NULL, 0);
       r->pid = 0;
     }
-    if (failed || getenv("SCDT_SHOW_LOGS"))
+    if (show_logs || getenv("SCDT_SHOW_LOGS"))
       print_log(r->log);
     remove_dir(r->dir);
   }
   nrecords = 0;
-  if (failed)
-    fprintf(stderr, "%d check(s) failed\n", failed);
-  return failed ? 1 : 0;
 }
-
-void scdt_abort(void) { exit(scdt_finish() ? 1 : 1); }
 
 int scdt_daemon_prepare(scdt_daemon_t *d) {
   memset(d, 0, sizeof *d);
@@ -253,8 +245,8 @@ static double *sample(int surface, int density, size_t n, uint64_t seed) {
   double *xyz = malloc(n * 3 * sizeof(double));
   if (!xyz)
     return NULL;
-  if (sc_sample_surface((sc_surface_t)surface, density, n, seed, xyz) !=
-      SC_TS_OK) {
+  if (scs_sample_surface((scs_surface_t)surface, density, n, seed, xyz) !=
+      SCS_OK) {
     free(xyz);
     return NULL;
   }
@@ -262,35 +254,11 @@ static double *sample(int surface, int density, size_t n, uint64_t seed) {
 }
 
 double *scdt_sample(int surface, size_t n, uint64_t seed) {
-  return sample(surface, SC_DENSITY_UNIFORM, n, seed);
+  return sample(surface, SCS_DENSITY_UNIFORM, n, seed);
 }
 
 double *scdt_sample_random(int surface, size_t n, uint64_t seed) {
-  return sample(surface, SC_DENSITY_UNIFORM_RANDOM, n, seed);
-}
-
-void scdt_run_ok(scdt_conn_t *c, uint32_t id, int surface, const double *xyz,
-                 size_t n, int timeout_ms, const char *when) {
-  scdt_job_t j;
-  scdt_job_init(&j, id, xyz, n);
-  scdt_job_t *pj = &j;
-  char why[512] = "";
-  CHECK(scdt_job_send(c, &j) == 0, "%s: send", when);
-  CHECK(scdt_collect(c, &pj, 1, timeout_ms, why, sizeof why) == 0, "%s: %s",
-        when, why);
-  CHECK(scdt_mesh_ok(surface, &j, why, sizeof why), "%s: %s", when, why);
-  scdt_job_reset(&j);
-}
-
-void scdt_check_serving(const char *sock, int surface, const double *xyz,
-                        size_t n, int timeout_ms, const char *when) {
-  scdt_conn_t *c;
-  int rc = scdt_open(sock, 1u << 20, &c);
-  CHECK(rc == 0, "%s: cannot connect: %d", when, rc);
-  if (rc != 0)
-    return;
-  scdt_run_ok(c, 1, surface, xyz, n, timeout_ms, when);
-  scdt_close(c);
+  return sample(surface, SCS_DENSITY_UNIFORM_RANDOM, n, seed);
 }
 
 int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {
@@ -299,20 +267,19 @@ int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {
              scp_wire_name(j->error_code), j->error_msg);
     return 0;
   }
-  sc_meshcheck_t mc;
-  if (sc_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SC_TS_OK) {
+  scs_meshcheck_t mc;
+  if (scs_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SCS_OK) {
     snprintf(why, len, "job %u: mesh check failed to run", j->id);
     return 0;
   }
   char reason[512];
-  int ok = sc_meshcheck_expect(&mc, (sc_surface_t)surface, SC_EXPECT_OUTWARD,
-                               reason, sizeof reason);
+  int ok = scs_meshcheck_expect(&mc, (scs_surface_t)surface, SCS_EXPECT_OUTWARD,
+                                reason, sizeof reason);
   if (!ok) {
     char sum[512];
     snprintf(why, len, "job %u (%s, %llu points): %s; %s", j->id,
-             sc_surface_name((sc_surface_t)surface),
-             (unsigned long long)j->n, reason,
-             sc_meshcheck_summary(&mc, sum, sizeof sum));
+             scs_surface_name((scs_surface_t)surface), (unsigned long long)j->n,
+             reason, scs_meshcheck_summary(&mc, sum, sizeof sum));
   } else if (j->diag_triangles != j->ntri) {
     snprintf(why, len, "job %u: JOB_DONE diagnostics say %llu triangles, "
              "%llu came",
@@ -324,7 +291,7 @@ int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len) {
              j->id, (long long)j->diag_genus, (long long)mc.genus_total);
     ok = 0;
   }
-  sc_meshcheck_free(&mc);
+  scs_meshcheck_free(&mc);
   return ok;
 }
 
@@ -334,8 +301,8 @@ int scdt_mesh_closed(const scdt_job_t *j, char *why, size_t len) {
              scp_wire_name(j->error_code), j->error_msg);
     return 0;
   }
-  sc_meshcheck_t mc;
-  if (sc_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SC_TS_OK) {
+  scs_meshcheck_t mc;
+  if (scs_meshcheck(j->n, j->xyz, j->tri, j->ntri, NULL, &mc) != SCS_OK) {
     snprintf(why, len, "job %u: mesh check failed to run", j->id);
     return 0;
   }
@@ -343,9 +310,9 @@ int scdt_mesh_closed(const scdt_job_t *j, char *why, size_t len) {
   if (!ok) {
     char sum[512];
     snprintf(why, len, "job %u: not a closed oriented manifold: %s", j->id,
-             sc_meshcheck_summary(&mc, sum, sizeof sum));
+             scs_meshcheck_summary(&mc, sum, sizeof sum));
   }
-  sc_meshcheck_free(&mc);
+  scs_meshcheck_free(&mc);
   return ok;
 }
 

@@ -2,8 +2,10 @@
  * Running the real daemon for a test: each test starts shortcrustd on a
  * private socket in a fresh temporary directory, with its stderr in a log
  * file there, and stops it with SIGTERM (checking the exit status) at the
- * end. Plus thread-safe checks that print both sides, point samples, and
- * the mesh check every result goes through.
+ * end. Plus point samples and the mesh check every result goes through.
+ *
+ * Nothing here checks or counts: the benchmark uses it too. The tests'
+ * side (recording failures, stopping on a fatal one) is daemontest.h.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -11,47 +13,11 @@
 #ifndef SCDT_HARNESS_H
 #define SCDT_HARNESS_H
 
-#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <sys/types.h>
 
 #include "client.h"
-
-extern atomic_int scdt_failures;
-
-#define CHECK(cond, ...)                                                       \
-  do {                                                                         \
-    if (!(cond)) {                                                             \
-      fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__,        \
-              #cond);                                                          \
-      fprintf(stderr, __VA_ARGS__);                                            \
-      fputc('\n', stderr);                                                     \
-      atomic_fetch_add(&scdt_failures, 1);                                     \
-    }                                                                          \
-  } while (0)
-
-#define CHECK_EQ(a, b)                                                         \
-  do {                                                                         \
-    long long a_ = (long long)(a), b_ = (long long)(b);                        \
-    if (a_ != b_) {                                                            \
-      fprintf(stderr, "%s:%d: check failed: %s == %s: %lld vs %lld\n",         \
-              __FILE__, __LINE__, #a, #b, a_, b_);                             \
-      atomic_fetch_add(&scdt_failures, 1);                                     \
-    }                                                                          \
-  } while (0)
-
-/* Stops the test at once (after printing) when a precondition fails. */
-#define REQUIRE(cond, ...)                                                     \
-  do {                                                                         \
-    if (!(cond)) {                                                             \
-      fprintf(stderr, "%s:%d: required: %s: ", __FILE__, __LINE__, #cond);     \
-      fprintf(stderr, __VA_ARGS__);                                            \
-      fputc('\n', stderr);                                                     \
-      atomic_fetch_add(&scdt_failures, 1);                                     \
-      scdt_abort();                                                            \
-    }                                                                          \
-  } while (0)
 
 typedef struct scdt_daemon {
   pid_t pid;
@@ -63,13 +29,12 @@ typedef struct scdt_daemon {
 } scdt_daemon_t;
 
 /* argv[1] is the daemon binary. Also ignores SIGPIPE. */
-void scdt_init(int argc, char **argv);
+void scdt_setup(int argc, char **argv);
 const char *scdt_daemon_binary(void);
-/* Removes every daemon's directory (and kills those still running), prints
- * their logs when a check failed, and returns the exit code. */
-int scdt_finish(void);
-/* Like scdt_finish(), for REQUIRE. */
-void scdt_abort(void) __attribute__((noreturn));
+/* Kills the daemons still running and removes every daemon's directory,
+ * printing their logs first when show_logs is set (or SCDT_SHOW_LOGS is
+ * in the environment). */
+void scdt_cleanup(int show_logs);
 
 /* A new private directory; fills d->dir, d->sock ("DIR/d.sock") and d->log
  * without starting anything. */
@@ -95,7 +60,7 @@ int scdt_log_wait(const scdt_daemon_t *d, const char *text, int timeout_ms);
 /* Counts lines of the log containing the text. */
 int scdt_log_count(const scdt_daemon_t *d, const char *text);
 
-/* Well-spaced samples of a test surface (sc_surface_t), malloc'd. */
+/* Well-spaced samples of a test surface (scs_surface_t), malloc'd. */
 double *scdt_sample(int surface, size_t n, uint64_t seed);
 /* Independent uniform samples: much quicker to make, for jobs that are
  * meant to be stopped rather than checked. */
@@ -104,14 +69,6 @@ double *scdt_sample_random(int surface, size_t n, uint64_t seed);
  * (closed manifold, oriented, right components and genus); otherwise 0
  * with the reason in why. */
 int scdt_mesh_ok(int surface, const scdt_job_t *j, char *why, size_t len);
-
-/* Runs the n points as job `id` on c and checks, recording any failure,
- * that a correct mesh of `surface` comes back; `when` heads the messages. */
-void scdt_run_ok(scdt_conn_t *c, uint32_t id, int surface, const double *xyz,
-                 size_t n, int timeout_ms, const char *when);
-/* The same on a fresh connection to sock: the daemon still serves. */
-void scdt_check_serving(const char *sock, int surface, const double *xyz,
-                        size_t n, int timeout_ms, const char *when);
 
 /* 1 when job j came back as a closed, oriented 2-manifold over its own
  * points, whatever its genus; otherwise 0 with the reason in why. */

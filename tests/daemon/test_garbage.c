@@ -12,8 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness.h"
-#include "testsupport.h"
+#include "daemontest.h"
+#include "synth.h"
 
 #define T_MS 120000
 
@@ -21,7 +21,7 @@ static scdt_daemon_t d;
 static double *sphere; /* 3000 points */
 
 static void check_serving(const char *when) {
-  scdt_check_serving(d.sock, SC_SURF_SPHERE, sphere, 3000, T_MS, when);
+  scdt_check_serving(d.sock, SCS_SURF_SPHERE, sphere, 3000, T_MS, when);
 }
 
 /* Sends raw bytes on a fresh connection (before any handshake unless
@@ -29,16 +29,16 @@ static void check_serving(const char *when) {
 static void expect_fatal(const char *what, int handshake, const void *bytes,
                          size_t len, uint32_t code) {
   scdt_conn_t *c;
-  REQUIRE(scdt_connect(d.sock, &c) == 0, "%s: connect", what);
+  ASSERT_MSG(scdt_connect(d.sock, &c) == 0, "%s: connect", what);
   if (handshake)
-    CHECK(scdt_handshake(c, SCP_FRAME_MIN) == 0, "%s: handshake", what);
+    EXPECT_MSG(scdt_handshake(c, SCP_FRAME_MIN) == 0, "%s: handshake", what);
   scdt_send_raw(c, bytes, len, T_MS);
-  CHECK(scdt_wait_closed(c, T_MS), "%s: not closed", what);
-  CHECK(c->got_error && c->last_error.code == code &&
-            (c->last_error.flags & SCP_ERROR_FATAL),
-        "%s: want a fatal %s, got %s%s", what, scp_wire_name(code),
-        c->got_error ? "" : "nothing ",
-        c->got_error ? scp_wire_name(c->last_error.code) : "");
+  EXPECT_MSG(scdt_wait_closed(c, T_MS), "%s: not closed", what);
+  EXPECT_MSG(c->got_error && c->last_error.code == code &&
+                 (c->last_error.flags & SCP_ERROR_FATAL),
+             "%s: want a fatal %s, got %s%s", what, scp_wire_name(code),
+             c->got_error ? "" : "nothing ",
+             c->got_error ? scp_wire_name(c->last_error.code) : "");
   printf("%s: fatal %s: %s\n", what, scp_wire_name(c->last_error.code),
          c->last_error.message);
   scdt_close(c);
@@ -49,9 +49,9 @@ static void expect_fatal(const char *what, int handshake, const void *bytes,
 static void hang_up_after(const char *what, int handshake, const void *bytes,
                           size_t len) {
   scdt_conn_t *c;
-  REQUIRE(scdt_connect(d.sock, &c) == 0, "%s: connect", what);
+  ASSERT_MSG(scdt_connect(d.sock, &c) == 0, "%s: connect", what);
   if (handshake)
-    CHECK(scdt_handshake(c, SCP_FRAME_MIN) == 0, "%s: handshake", what);
+    EXPECT_MSG(scdt_handshake(c, SCP_FRAME_MIN) == 0, "%s: handshake", what);
   scdt_send_raw(c, bytes, len, T_MS);
   scdt_close(c);
   check_serving(what);
@@ -76,13 +76,13 @@ static void malformed(void) {
 
   /* Versions the server does not speak: the handshake itself fails. */
   scdt_conn_t *c;
-  REQUIRE(scdt_connect(d.sock, &c) == 0, "connect");
+  ASSERT_MSG(scdt_connect(d.sock, &c) == 0, "connect");
   int rc = scdt_handshake_v(c, 2, 3, SCP_FRAME_MIN, T_MS);
-  CHECK_EQ(rc, SCP_WIRE_VERSION);
-  CHECK(strstr(c->last_error.message, "versions 1 to 1") != NULL,
-        "message: %s", c->last_error.message);
+  EXPECT_EQ(rc, SCP_WIRE_VERSION);
+  EXPECT_MSG(strstr(c->last_error.message, "versions 1 to 1") != NULL,
+             "message: %s", c->last_error.message);
   printf("wrong version: %s\n", c->last_error.message);
-  CHECK(scdt_wait_closed(c, T_MS), "not closed");
+  EXPECT_MSG(scdt_wait_closed(c, T_MS), "not closed");
   scdt_close(c);
 
   /* A frame before the handshake. */
@@ -126,7 +126,7 @@ static void put(scp_buf_t *b, const void *bytes, size_t len) {
   if (b->cap - b->len < len) {
     size_t cap = b->len + len + 256;
     b->data = realloc(b->data, cap);
-    REQUIRE(b->data != NULL, "out of memory");
+    ASSERT_MSG(b->data != NULL, "out of memory");
     b->cap = cap;
   }
   memcpy(b->data + b->len, bytes, len);
@@ -138,42 +138,42 @@ static void put(scp_buf_t *b, const void *bytes, size_t len) {
 static void expect_error(scdt_conn_t *c, scp_buf_t *b, uint32_t code,
                          const char *what) {
   scp_enc_ping(b, 99);
-  CHECK(scdt_send_raw(c, b->data, b->len, T_MS) == 0, "%s: send", what);
+  EXPECT_MSG(scdt_send_raw(c, b->data, b->len, T_MS) == 0, "%s: send", what);
   b->len = 0;
   scdt_frame_t *f = scdt_recv(c, T_MS);
   scp_frame_t v;
   scp_error_t e;
   memset(&e, 0, sizeof e);
-  CHECK(f && f->type == SCP_ERROR, "%s: want ERROR, got %s", what,
-        f ? scp_type_name(f->type) : "nothing");
+  EXPECT_MSG(f && f->type == SCP_ERROR, "%s: want ERROR, got %s", what,
+             f ? scp_type_name(f->type) : "nothing");
   if (f && f->type == SCP_ERROR) {
     scdt_frame_view(f, &v);
-    CHECK(scp_parse_error(&v, &e) == 0, "%s: bad ERROR", what);
-    CHECK(e.code == code && !(e.flags & SCP_ERROR_FATAL),
-          "%s: want %s, got %s%s (%s)", what, scp_wire_name(code),
-          (e.flags & SCP_ERROR_FATAL) ? "fatal " : "", scp_wire_name(e.code),
-          e.message);
+    EXPECT_MSG(scp_parse_error(&v, &e) == 0, "%s: bad ERROR", what);
+    EXPECT_MSG(e.code == code && !(e.flags & SCP_ERROR_FATAL),
+               "%s: want %s, got %s%s (%s)", what, scp_wire_name(code),
+               (e.flags & SCP_ERROR_FATAL) ? "fatal " : "",
+               scp_wire_name(e.code), e.message);
   }
   free(f);
   f = scdt_recv(c, T_MS);
-  CHECK(f && f->type == SCP_PONG, "%s: want PONG, got %s", what,
-        f ? scp_type_name(f->type) : "nothing");
+  EXPECT_MSG(f && f->type == SCP_PONG, "%s: want PONG, got %s", what,
+             f ? scp_type_name(f->type) : "nothing");
   free(f);
 }
 
 /* Expects exactly one JOB_ERROR for the job with the code. */
 static void expect_job_error(scdt_conn_t *c, scdt_job_t *j, uint32_t code) {
   char why[512] = "";
-  CHECK(scdt_collect(c, &j, 1, T_MS, why, sizeof why) == 0, "%s", why);
-  CHECK(j->error_code == code, "job %u: got %s (%s), want %s", j->id,
-        scp_wire_name(j->error_code), j->error_msg, scp_wire_name(code));
+  EXPECT_MSG(scdt_collect(c, &j, 1, T_MS, why, sizeof why) == 0, "%s", why);
+  EXPECT_MSG(j->error_code == code, "job %u: got %s (%s), want %s", j->id,
+             scp_wire_name(j->error_code), j->error_msg, scp_wire_name(code));
   printf("job %u: %s: %s\n", j->id, scp_wire_name(j->error_code),
          j->error_msg);
 }
 
 static void invalid_requests(void) {
   scdt_conn_t *c;
-  REQUIRE(scdt_open(d.sock, SCP_FRAME_MIN, &c) == 0, "connect");
+  ASSERT_MSG(scdt_open(d.sock, SCP_FRAME_MIN, &c) == 0, "connect");
   scp_buf_t b;
   scp_buf_init(&b, SCP_FRAME_MIN);
 
@@ -187,12 +187,12 @@ static void invalid_requests(void) {
   /* An unknown ignorable type is skipped silently: the PONG comes next. */
   uint8_t ignorable[12] = {0x00, 0x90, 0, 0, 4, 0, 0, 0, 1, 2, 3, 4};
   scp_enc_ping(&b, 5);
-  CHECK(scdt_send_raw(c, ignorable, sizeof ignorable, T_MS) == 0, "send");
-  CHECK(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
+  EXPECT_MSG(scdt_send_raw(c, ignorable, sizeof ignorable, T_MS) == 0, "send");
+  EXPECT_MSG(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
   b.len = 0;
   scdt_frame_t *f = scdt_recv(c, T_MS);
-  CHECK(f && f->type == SCP_PONG, "ignorable type: want PONG, got %s",
-        f ? scp_type_name(f->type) : "nothing");
+  EXPECT_MSG(f && f->type == SCP_PONG, "ignorable type: want PONG, got %s",
+             f ? scp_type_name(f->type) : "nothing");
   free(f);
 
   /* Frames for jobs not in use. */
@@ -214,31 +214,31 @@ static void invalid_requests(void) {
   scp_enc_job_begin(&b, &jb);
   b.data[8 + 8 + 7] = 0x3f;
   b.data[8 + 8 + 6] = 0xf0; /* r = 1.0 */
-  CHECK(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
+  EXPECT_MSG(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
   b.len = 0;
   expect_job_error(c, &j, SCP_WIRE_INVALID);
   scp_enc_points(&b, 3, 0, SCP_F64_XYZ, sphere, 10); /* discarded */
   scp_enc_job_end(&b, &(scp_job_end_t){.job_id = 3, .point_count = 10});
-  CHECK(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
+  EXPECT_MSG(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
   b.len = 0;
 
   /* A mode version 1 does not have. */
   scp_enc_job_begin(&b, &jb);
   b.data[8 + 4] = 5;
-  CHECK(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
+  EXPECT_MSG(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
   b.len = 0;
   scdt_job_reset(&j);
   expect_job_error(c, &j, SCP_WIRE_INVALID);
-  CHECK(scdt_job_cancel(c, &j) == 0, "cancel");
+  EXPECT_MSG(scdt_job_cancel(c, &j) == 0, "cancel");
 
   /* Duplicate id. */
   scdt_job_reset(&j);
   j.mode = SCP_MODE_COCONE;
-  CHECK(scdt_job_begin(c, &j) == 0, "send");
+  EXPECT_MSG(scdt_job_begin(c, &j) == 0, "send");
   scp_job_begin_t dup = {.job_id = 3, .mode = 1, .r = 0.25};
   scp_enc_job_begin(&b, &dup);
   scdt_frame_t *acc = scdt_recv(c, T_MS);
-  CHECK(acc && acc->type == SCP_ACCEPTED, "want ACCEPTED");
+  EXPECT_MSG(acc && acc->type == SCP_ACCEPTED, "want ACCEPTED");
   free(acc);
   expect_error(c, &b, SCP_WIRE_DUPLICATE_JOB, "duplicate job");
   /* An invalid JOB_BEGIN is judged by its id first: one in use is a
@@ -252,32 +252,32 @@ static void invalid_requests(void) {
 
   /* Points out of order. */
   scp_enc_points(&b, 3, 5, SCP_F64_XYZ, sphere, 10);
-  CHECK(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
+  EXPECT_MSG(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
   b.len = 0;
   j.accepted = 0;
   expect_job_error(c, &j, SCP_WIRE_INVALID);
-  CHECK(scdt_job_end(c, &j) == 0, "end");
+  EXPECT_MSG(scdt_job_end(c, &j) == 0, "end");
 
   /* JOB_END with the wrong count. */
   scdt_job_reset(&j);
-  CHECK(scdt_job_begin(c, &j) == 0 && scdt_job_points(c, &j, 3000) == 0,
-        "send");
+  EXPECT_MSG(scdt_job_begin(c, &j) == 0 && scdt_job_points(c, &j, 3000) == 0,
+             "send");
   j.sent = 2999;
-  CHECK(scdt_job_end(c, &j) == 0, "end");
+  EXPECT_MSG(scdt_job_end(c, &j) == 0, "end");
   expect_job_error(c, &j, SCP_WIRE_INVALID);
 
   /* POINTS after JOB_END: the job is working, not uploading. */
   scdt_job_reset(&j);
-  CHECK(scdt_job_send(c, &j) == 0, "send");
+  EXPECT_MSG(scdt_job_send(c, &j) == 0, "send");
   scp_enc_points(&b, 3, 3000, SCP_F64_XYZ, sphere, 10);
-  CHECK(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
+  EXPECT_MSG(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
   b.len = 0;
   char why[512] = "";
   scdt_job_t *pj = &j;
-  CHECK(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s", why);
-  CHECK(c->got_error && c->last_error.code == SCP_WIRE_STATE,
-        "want ERROR STATE, got %s", scp_wire_name(c->last_error.code));
-  CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &j, why, sizeof why), "%s", why);
+  EXPECT_MSG(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s", why);
+  EXPECT_MSG(c->got_error && c->last_error.code == SCP_WIRE_STATE,
+             "want ERROR STATE, got %s", scp_wire_name(c->last_error.code));
+  EXPECT_MSG(scdt_mesh_ok(SCS_SURF_SPHERE, &j, why, sizeof why), "%s", why);
   scdt_job_reset(&j);
 
   /* Bad points: a NaN, and points all in one plane. */
@@ -285,7 +285,7 @@ static void invalid_requests(void) {
   memcpy(bad, sphere, 3000 * 3 * sizeof(double));
   bad[3 * 1234 + 1] = NAN;
   scdt_job_init(&j, 4, bad, 3000);
-  CHECK(scdt_job_send(c, &j) == 0, "send");
+  EXPECT_MSG(scdt_job_send(c, &j) == 0, "send");
   expect_job_error(c, &j, SCP_WIRE_NONFINITE);
   double flat[3 * 50];
   for (int i = 0; i < 50; i++) {
@@ -294,10 +294,10 @@ static void invalid_requests(void) {
     flat[3 * i + 2] = 0;
   }
   scdt_job_init(&j, 5, flat, 50);
-  CHECK(scdt_job_send(c, &j) == 0, "send");
+  EXPECT_MSG(scdt_job_send(c, &j) == 0, "send");
   expect_job_error(c, &j, SCP_WIRE_DEGENERATE_INPUT);
   scdt_job_init(&j, 6, flat, 0);
-  CHECK(scdt_job_send(c, &j) == 0, "send");
+  EXPECT_MSG(scdt_job_send(c, &j) == 0, "send");
   expect_job_error(c, &j, SCP_WIRE_DEGENERATE_INPUT);
   free(bad);
 
@@ -306,10 +306,12 @@ static void invalid_requests(void) {
     put(&b, zero_cancel, sizeof zero_cancel);
   scdt_send_raw(c, b.data, b.len, T_MS);
   b.len = 0;
-  CHECK(scdt_wait_closed(c, T_MS), "not closed after 150 invalid requests");
-  CHECK(c->got_error && c->last_error.code == SCP_WIRE_PROTOCOL &&
-            (c->last_error.flags & SCP_ERROR_FATAL),
-        "want a fatal PROTOCOL, got %s", scp_wire_name(c->last_error.code));
+  EXPECT_MSG(scdt_wait_closed(c, T_MS),
+             "not closed after 150 invalid requests");
+  EXPECT_MSG(c->got_error && c->last_error.code == SCP_WIRE_PROTOCOL &&
+                 (c->last_error.flags & SCP_ERROR_FATAL),
+             "want a fatal PROTOCOL, got %s",
+             scp_wire_name(c->last_error.code));
   scp_buf_free(&b);
   scdt_close(c);
   check_serving("after invalid requests");
@@ -318,13 +320,13 @@ static void invalid_requests(void) {
 int main(int argc, char **argv) {
   scdt_init(argc, argv);
   const char *args[] = {"--workers", "2", NULL};
-  REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
-  sphere = scdt_sample(SC_SURF_SPHERE, 3000, 11);
+  ASSERT_MSG(scdt_daemon_start(&d, args) == 0, "daemon did not start");
+  sphere = scdt_sample(SCS_SURF_SPHERE, 3000, 11);
   malformed();
   invalid_requests();
-  CHECK_EQ(scdt_stat_wait(d.sock, "jobs_active", 0, T_MS), 0);
-  CHECK_EQ(scdt_stat_wait(d.sock, "memory_jobs_bytes", 0, T_MS), 0);
-  CHECK_EQ(scdt_daemon_stop(&d), 0);
+  EXPECT_EQ(scdt_stat_wait(d.sock, "jobs_active", 0, T_MS), 0);
+  EXPECT_EQ(scdt_stat_wait(d.sock, "memory_jobs_bytes", 0, T_MS), 0);
+  EXPECT_EQ(scdt_daemon_stop(&d), 0);
   free(sphere);
   return scdt_finish();
 }

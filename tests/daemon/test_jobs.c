@@ -16,10 +16,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness.h"
-#include "testsupport.h"
+#include "daemontest.h"
+#include "synth.h"
 
-static const int surfaces[] = {SC_SURF_SPHERE, SC_SURF_TORUS, SC_SURF_GENUS2};
+static const int surfaces[] = {SCS_SURF_SPHERE, SCS_SURF_TORUS,
+                               SCS_SURF_GENUS2};
 static const size_t sizes[] = {2000, 3000, 4000};
 
 typedef struct client_arg {
@@ -31,7 +32,7 @@ typedef struct client_arg {
 static void check_normals(const scdt_job_t *j) {
   if (!(j->flags & SCP_JOB_NORMALS))
     return;
-  CHECK_EQ(j->nnormals, j->n);
+  EXPECT_EQ(j->nnormals, j->n);
   unsigned char *used = calloc(j->n, 1);
   for (uint64_t i = 0; i < 3 * j->ntri; i++)
     used[j->tri[i]] = 1;
@@ -42,8 +43,8 @@ static void check_normals(const scdt_job_t *j) {
     if (used[i] && fabs(len - 1) > 1e-5)
       bad++;
   }
-  CHECK(bad == 0, "job %u: %llu normals of used points are not unit", j->id,
-        (unsigned long long)bad);
+  EXPECT_MSG(bad == 0, "job %u: %llu normals of used points are not unit",
+             j->id, (unsigned long long)bad);
   free(used);
 }
 
@@ -53,10 +54,10 @@ static void *run_client(void *p) {
   uint32_t max_frame = (a->index % 2) ? SCP_FRAME_MIN : (1u << 20);
   scdt_conn_t *c;
   int rc = scdt_open(a->sock, max_frame, &c);
-  CHECK(rc == 0, "client %d: open: %d", a->index, rc);
+  EXPECT_MSG(rc == 0, "client %d: open: %d", a->index, rc);
   if (rc != 0)
     return NULL;
-  CHECK_EQ(c->welcome.max_frame, max_frame);
+  EXPECT_EQ(c->welcome.max_frame, max_frame);
 
   scdt_job_t *jobs = calloc((size_t)nj, sizeof *jobs);
   scdt_job_t **ptrs = calloc((size_t)nj, sizeof *ptrs);
@@ -103,21 +104,21 @@ static void *run_client(void *p) {
   }
   for (int k = 0; k < nj && ok; k++)
     ok = scdt_job_end(c, &jobs[k]) == 0;
-  CHECK(ok, "client %d: sending failed", a->index);
+  EXPECT_MSG(ok, "client %d: sending failed", a->index);
   char why[512] = "";
   rc = scdt_collect(c, ptrs, (size_t)nj, 300000, why, sizeof why);
-  CHECK(rc == 0, "client %d: %s", a->index, why);
+  EXPECT_MSG(rc == 0, "client %d: %s", a->index, why);
   for (int k = 0; k < nj; k++) {
-    CHECK(jobs[k].accepted, "job %u not accepted", jobs[k].id);
+    EXPECT_MSG(jobs[k].accepted, "job %u not accepted", jobs[k].id);
     if (jobs[k].mode == SCP_MODE_SHORTCRUST || jobs[k].mode == SCP_MODE_AUTO) {
-      CHECK(jobs[k].done && jobs[k].ntri > 0, "job %u (mode %s): %s",
-            jobs[k].id, scp_mode_name(jobs[k].mode), jobs[k].error_msg);
+      EXPECT_MSG(jobs[k].done && jobs[k].ntri > 0, "job %u (mode %s): %s",
+                 jobs[k].id, scp_mode_name(jobs[k].mode), jobs[k].error_msg);
     } else if (jobs[k].mode == SCP_MODE_WATERTIGHT) {
       ok = scdt_mesh_closed(&jobs[k], why, sizeof why);
-      CHECK(ok, "mode watertight: %s", why);
+      EXPECT_MSG(ok, "mode watertight: %s", why);
     } else {
       ok = scdt_mesh_ok(surf[k], &jobs[k], why, sizeof why);
-      CHECK(ok, "mode %s: %s", scp_mode_name(jobs[k].mode), why);
+      EXPECT_MSG(ok, "mode %s: %s", scp_mode_name(jobs[k].mode), why);
     }
     check_normals(&jobs[k]);
     free((void *)jobs[k].xyz);
@@ -136,7 +137,7 @@ int main(int argc, char **argv) {
   int njobs = argc > 3 ? atoi(argv[3]) : 3;
   scdt_daemon_t d;
   const char *args[] = {"--workers", "2", NULL};
-  REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon did not start");
+  ASSERT_MSG(scdt_daemon_start(&d, args) == 0, "daemon did not start");
 
   uint64_t t0 = scdt_now_ms();
   pthread_t *th = calloc((size_t)nconn, sizeof *th);
@@ -151,13 +152,13 @@ int main(int argc, char **argv) {
          (double)(scdt_now_ms() - t0) / 1e3);
 
   uint64_t total = (uint64_t)nconn * (uint64_t)njobs;
-  CHECK_EQ(scdt_stat_fresh(d.sock, "jobs_done_total"), total);
-  CHECK_EQ(scdt_stat_fresh(d.sock, "jobs_failed_total"), 0);
-  CHECK_EQ(scdt_stat_wait(d.sock, "jobs_active", 0, 10000), 0);
-  CHECK_EQ(scdt_stat_wait(d.sock, "memory_jobs_bytes", 0, 10000), 0);
-  CHECK_EQ(scdt_stat_wait(d.sock, "connections", 1, 10000), 1);
-  CHECK_EQ(scdt_daemon_stop(&d), 0);
-  CHECK_EQ(scdt_log_count(&d, " done: points="), total);
+  EXPECT_EQ(scdt_stat_fresh(d.sock, "jobs_done_total"), total);
+  EXPECT_EQ(scdt_stat_fresh(d.sock, "jobs_failed_total"), 0);
+  EXPECT_EQ(scdt_stat_wait(d.sock, "jobs_active", 0, 10000), 0);
+  EXPECT_EQ(scdt_stat_wait(d.sock, "memory_jobs_bytes", 0, 10000), 0);
+  EXPECT_EQ(scdt_stat_wait(d.sock, "connections", 1, 10000), 1);
+  EXPECT_EQ(scdt_daemon_stop(&d), 0);
+  EXPECT_EQ(scdt_log_count(&d, " done: points="), total);
   free(th);
   free(ca);
   return scdt_finish();

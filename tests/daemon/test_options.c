@@ -11,9 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness.h"
+#include "daemontest.h"
 #include "shortcrust.h"
-#include "testsupport.h"
+#include "synth.h"
 
 #define T_MS 120000
 #define N 3000
@@ -26,19 +26,19 @@ static double *torus;
 
 static scdt_conn_t *open_conn(uint64_t features) {
   scdt_conn_t *c;
-  REQUIRE(scdt_connect(d.sock, &c) == 0, "connect");
+  ASSERT_MSG(scdt_connect(d.sock, &c) == 0, "connect");
   c->features = features;
-  REQUIRE(scdt_handshake(c, 1u << 20) == 0, "handshake");
+  ASSERT_MSG(scdt_handshake(c, 1u << 20) == 0, "handshake");
   return c;
 }
 
 /* Runs a job on c and collects it. */
 static void run(scdt_conn_t *c, scdt_job_t *j) {
   char why[512] = "";
-  REQUIRE(scdt_job_send(c, j) == 0, "job %u: send", j->id);
+  ASSERT_MSG(scdt_job_send(c, j) == 0, "job %u: send", j->id);
   scdt_job_t *js[1] = {j};
-  CHECK(scdt_collect(c, js, 1, T_MS, why, sizeof why) == 0, "job %u: %s",
-        j->id, why);
+  EXPECT_MSG(scdt_collect(c, js, 1, T_MS, why, sizeof why) == 0, "job %u: %s",
+             j->id, why);
 }
 
 /* The core's mesh of the torus with these parameters, the threads the
@@ -47,8 +47,8 @@ static sc_mesh_t *direct(sc_params_t p) {
   sc_mesh_t *m = NULL;
   char msg[256];
   p.threads = 1;
-  REQUIRE(sc_reconstruct(torus, N, &p, &m, msg, sizeof msg) == SC_OK, "%s",
-          msg);
+  ASSERT_MSG(sc_reconstruct(torus, N, &p, &m, msg, sizeof msg) == SC_OK, "%s",
+             msg);
   return m;
 }
 
@@ -59,10 +59,10 @@ static int same_mesh(const scdt_job_t *j, const sc_mesh_t *m) {
 
 static void features(void) {
   scdt_conn_t *a = open_conn(SCP_FEATURE_JOB_OPTIONS | (1ull << 40));
-  CHECK_EQ(a->welcome.features, SCP_FEATURE_JOB_OPTIONS);
+  EXPECT_EQ(a->welcome.features, SCP_FEATURE_JOB_OPTIONS);
   scdt_close(a);
   scdt_conn_t *b = open_conn(0);
-  CHECK_EQ(b->welcome.features, 0);
+  EXPECT_EQ(b->welcome.features, 0);
   scdt_close(b);
 }
 
@@ -97,15 +97,15 @@ static void options_apply(void) {
   p.paper_pruning = 1;
   p.watertight_labels = 1;
   sc_mesh_t *optioned = direct(p);
-  CHECK(plain->triangle_count != optioned->triangle_count,
-        "the options change nothing here (%zu triangles either way)",
-        plain->triangle_count);
-  CHECK(same_mesh(&with, optioned),
-        "job with options: %llu triangles, the core with them %zu",
-        (unsigned long long)with.ntri, optioned->triangle_count);
-  CHECK(same_mesh(&without, plain),
-        "job without options: %llu triangles, the core %zu",
-        (unsigned long long)without.ntri, plain->triangle_count);
+  EXPECT_MSG(plain->triangle_count != optioned->triangle_count,
+             "the options change nothing here (%zu triangles either way)",
+             plain->triangle_count);
+  EXPECT_MSG(same_mesh(&with, optioned),
+             "job with options: %llu triangles, the core with them %zu",
+             (unsigned long long)with.ntri, optioned->triangle_count);
+  EXPECT_MSG(same_mesh(&without, plain),
+             "job without options: %llu triangles, the core %zu",
+             (unsigned long long)without.ntri, plain->triangle_count);
   printf("boundary mode: %zu triangles by default, %zu with the options\n",
          plain->triangle_count, optioned->triangle_count);
   sc_mesh_free(plain);
@@ -122,16 +122,16 @@ static void expect_refused(scdt_conn_t *c, uint32_t id, scp_value_t opt,
   scdt_job_init(&j, id, sphere, N);
   j.options = &opt;
   j.noptions = 1;
-  REQUIRE(scdt_job_begin(c, &j) == 0, "job %u: send", id);
+  ASSERT_MSG(scdt_job_begin(c, &j) == 0, "job %u: send", id);
   char why[512] = "";
   scdt_job_t *js[1] = {&j};
-  CHECK(scdt_collect(c, js, 1, T_MS, why, sizeof why) == 0, "job %u: %s", id,
-        why);
-  CHECK(!j.accepted && j.error_code == code,
-        "%s: got %s (%s), want %s before ACCEPTED", opt.name,
-        scp_wire_name(j.error_code), j.error_msg, scp_wire_name(code));
-  CHECK(strstr(j.error_msg, text) != NULL, "%s: message '%s' lacks '%s'",
-        opt.name, j.error_msg, text);
+  EXPECT_MSG(scdt_collect(c, js, 1, T_MS, why, sizeof why) == 0, "job %u: %s",
+             id, why);
+  EXPECT_MSG(!j.accepted && j.error_code == code,
+             "%s: got %s (%s), want %s before ACCEPTED", opt.name,
+             scp_wire_name(j.error_code), j.error_msg, scp_wire_name(code));
+  EXPECT_MSG(strstr(j.error_msg, text) != NULL, "%s: message '%s' lacks '%s'",
+             opt.name, j.error_msg, text);
   printf("%s: %s: %s\n", opt.name, scp_wire_name(j.error_code), j.error_msg);
   scdt_job_reset(&j);
 }
@@ -163,7 +163,7 @@ static void options_refused(void) {
   scp_buf_init(&b, 1u << 20);
   scp_value_t one = {.name = "x", .kind = SCP_KIND_U64, .v.u = 0};
   scp_job_begin_t m = {.job_id = 16, .mode = SCP_MODE_COCONE, .r = 0.25};
-  REQUIRE(scp_enc_job_begin_options(&b, &m, &one, 1) == 0, "encode");
+  ASSERT_MSG(scp_enc_job_begin_options(&b, &m, &one, 1) == 0, "encode");
   /* The header, then the payload: count at 40 (little-endian, as is the
    * header's payload length at 4), the entry at 48, cut off. */
   memset(b.data + SCP_HEADER_SIZE + 40, 0, 4);
@@ -171,16 +171,16 @@ static void options_refused(void) {
   b.data[4] = 48, b.data[5] = b.data[6] = b.data[7] = 0;
   scdt_send_raw(c, b.data, b.len, T_MS);
   scdt_frame_t *f = scdt_recv(c, T_MS);
-  REQUIRE(f != NULL, "no answer to an empty option list");
+  ASSERT_MSG(f != NULL, "no answer to an empty option list");
   scp_frame_t v;
   scdt_frame_view(f, &v);
   scp_job_error_t e;
-  CHECK(f->type == SCP_JOB_ERROR && scp_parse_job_error(&v, &e) == 0 &&
-            e.job_id == 16 && e.code == SCP_WIRE_INVALID,
-        "empty option list: got frame type 0x%04x", f->type);
+  EXPECT_MSG(f->type == SCP_JOB_ERROR && scp_parse_job_error(&v, &e) == 0 &&
+                 e.job_id == 16 && e.code == SCP_WIRE_INVALID,
+             "empty option list: got frame type 0x%04x", f->type);
   free(f);
   scp_buf_free(&b);
-  scdt_run_ok(c, 17, SC_SURF_SPHERE, sphere, N, T_MS, "after refusals");
+  scdt_run_ok(c, 17, SCS_SURF_SPHERE, sphere, N, T_MS, "after refusals");
   scdt_close(c);
 
   /* Options on a connection that did not agree on them: malformed. */
@@ -189,30 +189,30 @@ static void options_refused(void) {
   scdt_job_init(&j, 1, sphere, N);
   j.options = &one;
   j.noptions = 1;
-  REQUIRE(scdt_job_begin(old, &j) == 0, "send");
-  CHECK(scdt_wait_closed(old, T_MS), "not closed");
-  CHECK(old->got_error && (old->last_error.flags & SCP_ERROR_FATAL) &&
-            old->last_error.code == SCP_WIRE_PROTOCOL,
-        "want a fatal PROTOCOL, got %s",
-        old->got_error ? scp_wire_name(old->last_error.code) : "nothing");
+  ASSERT_MSG(scdt_job_begin(old, &j) == 0, "send");
+  EXPECT_MSG(scdt_wait_closed(old, T_MS), "not closed");
+  EXPECT_MSG(old->got_error && (old->last_error.flags & SCP_ERROR_FATAL) &&
+                 old->last_error.code == SCP_WIRE_PROTOCOL,
+             "want a fatal PROTOCOL, got %s",
+             old->got_error ? scp_wire_name(old->last_error.code) : "nothing");
   printf("options without the feature: fatal %s: %s\n",
          scp_wire_name(old->last_error.code), old->last_error.message);
   scdt_close(old);
-  scdt_check_serving(d.sock, SC_SURF_SPHERE, sphere, N, T_MS,
+  scdt_check_serving(d.sock, SCS_SURF_SPHERE, sphere, N, T_MS,
                      "after a malformed JOB_BEGIN");
 }
 
 int main(int argc, char **argv) {
   scdt_init(argc, argv);
-  sphere = scdt_sample(SC_SURF_SPHERE, N, 3);
-  torus = scdt_sample_random(SC_SURF_TORUS, N, 3);
-  REQUIRE(sphere != NULL && torus != NULL, "sample");
+  sphere = scdt_sample(SCS_SURF_SPHERE, N, 3);
+  torus = scdt_sample_random(SCS_SURF_TORUS, N, 3);
+  ASSERT_MSG(sphere != NULL && torus != NULL, "sample");
   const char *args[] = {"--workers", "2", NULL};
-  REQUIRE(scdt_daemon_start(&d, args) == 0, "daemon");
+  ASSERT_MSG(scdt_daemon_start(&d, args) == 0, "daemon");
   features();
   options_apply();
   options_refused();
-  CHECK(scdt_daemon_stop(&d) == 0, "daemon stop: status %d", d.status);
+  EXPECT_MSG(scdt_daemon_stop(&d) == 0, "daemon stop: status %d", d.status);
   free(sphere);
   free(torus);
   return scdt_finish();

@@ -17,8 +17,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "harness.h"
-#include "testsupport.h"
+#include "daemontest.h"
+#include "synth.h"
 
 #define T_MS 120000
 
@@ -27,18 +27,18 @@ static double *sphere; /* 2000 points */
 static void check_job(const char *sock, const char *when) {
   scdt_conn_t *c;
   int rc = scdt_open(sock, 1u << 20, &c);
-  CHECK(rc == 0, "%s: cannot connect to %s: %d", when, sock, rc);
+  EXPECT_MSG(rc == 0, "%s: cannot connect to %s: %d", when, sock, rc);
   if (rc != 0)
     return;
   scdt_job_t j;
   scdt_job_init(&j, 1, sphere, 2000);
   scdt_job_t *pj = &j;
   char why[512] = "";
-  CHECK(scdt_job_send(c, &j) == 0, "%s: send", when);
-  CHECK(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s: %s", when,
-        why);
-  CHECK(scdt_mesh_ok(SC_SURF_SPHERE, &j, why, sizeof why), "%s: %s", when,
-        why);
+  EXPECT_MSG(scdt_job_send(c, &j) == 0, "%s: send", when);
+  EXPECT_MSG(scdt_collect(c, &pj, 1, T_MS, why, sizeof why) == 0, "%s: %s",
+             when, why);
+  EXPECT_MSG(scdt_mesh_ok(SCS_SURF_SPHERE, &j, why, sizeof why), "%s: %s", when,
+             why);
   scdt_job_reset(&j);
   scdt_close(c);
 }
@@ -133,55 +133,55 @@ static int wait_ready(const char *sock) {
 
 static void stale_and_second(void) {
   scdt_daemon_t d;
-  REQUIRE(scdt_daemon_prepare(&d) == 0, "prepare");
+  ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
   /* A dead daemon's socket: bound, then the process is gone. */
   int fd = bound_socket(d.sock, 1);
-  REQUIRE(fd >= 0, "bind %s: %s", d.sock, strerror(errno));
+  ASSERT_MSG(fd >= 0, "bind %s: %s", d.sock, strerror(errno));
   close(fd);
-  REQUIRE(scdt_daemon_spawn(&d, NULL, 1) == 0, "daemon did not start");
-  CHECK(scdt_log_contains(&d, "removing stale socket"), "no log line");
-  CHECK(mode_of(d.sock) == 0660, "mode %o, want 0660", mode_of(d.sock));
+  ASSERT_MSG(scdt_daemon_spawn(&d, NULL, 1) == 0, "daemon did not start");
+  EXPECT_MSG(scdt_log_contains(&d, "removing stale socket"), "no log line");
+  EXPECT_MSG(mode_of(d.sock) == 0660, "mode %o, want 0660", mode_of(d.sock));
   check_job(d.sock, "after replacing a stale socket");
 
   /* A second daemon on the same path refuses to start. */
   scdt_daemon_t second = d;
   second.pid = 0;
   snprintf(second.log, sizeof second.log, "%s/second.log", d.dir);
-  REQUIRE(scdt_daemon_spawn(&second, NULL, 0) == 0, "spawn");
+  ASSERT_MSG(scdt_daemon_spawn(&second, NULL, 0) == 0, "spawn");
   int st = scdt_daemon_wait(&second, T_MS);
-  CHECK(st != 0 && st > 0, "second daemon exited with %d", st);
-  CHECK(scdt_log_contains(&second, "refusing to start"),
-        "second daemon gave no clear message");
+  EXPECT_MSG(st != 0 && st > 0, "second daemon exited with %d", st);
+  EXPECT_MSG(scdt_log_contains(&second, "refusing to start"),
+             "second daemon gave no clear message");
   /* The first one is untouched. */
   check_job(d.sock, "after a second daemon tried");
-  CHECK_EQ(scdt_daemon_stop(&d), 0);
+  EXPECT_EQ(scdt_daemon_stop(&d), 0);
 }
 
 static void not_a_socket_and_foreign(void) {
   scdt_daemon_t d;
-  REQUIRE(scdt_daemon_prepare(&d) == 0, "prepare");
+  ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
   int f = open(d.sock, O_WRONLY | O_CREAT, 0644);
   close(f);
-  REQUIRE(scdt_daemon_spawn(&d, NULL, 0) == 0, "spawn");
-  CHECK(scdt_daemon_wait(&d, T_MS) > 0, "started over a regular file");
-  CHECK(scdt_log_contains(&d, "is not a socket"), "no clear message");
+  ASSERT_MSG(scdt_daemon_spawn(&d, NULL, 0) == 0, "spawn");
+  EXPECT_MSG(scdt_daemon_wait(&d, T_MS) > 0, "started over a regular file");
+  EXPECT_MSG(scdt_log_contains(&d, "is not a socket"), "no clear message");
   unlink(d.sock);
 
   /* Something alive listens there, and holds no lock of ours. */
   int fd = bound_socket(d.sock, 1);
-  REQUIRE(fd >= 0, "bind");
-  REQUIRE(scdt_daemon_spawn(&d, NULL, 0) == 0, "spawn");
-  CHECK(scdt_daemon_wait(&d, T_MS) > 0, "started over a live socket");
-  CHECK(scdt_log_contains(&d, "another daemon is listening"),
-        "no clear message");
-  CHECK(mode_of(d.sock) != 0, "the live socket was removed");
+  ASSERT_MSG(fd >= 0, "bind");
+  ASSERT_MSG(scdt_daemon_spawn(&d, NULL, 0) == 0, "spawn");
+  EXPECT_MSG(scdt_daemon_wait(&d, T_MS) > 0, "started over a live socket");
+  EXPECT_MSG(scdt_log_contains(&d, "another daemon is listening"),
+             "no clear message");
+  EXPECT_MSG(mode_of(d.sock) != 0, "the live socket was removed");
   close(fd);
   unlink(d.sock);
 }
 
 static void modes_and_defaults(void) {
   scdt_daemon_t d;
-  REQUIRE(scdt_daemon_prepare(&d) == 0, "prepare");
+  ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
   /* --socket-mode, and the default path under XDG_RUNTIME_DIR. */
   char env[200], sock[200];
   snprintf(env, sizeof env, "XDG_RUNTIME_DIR=%s", d.dir);
@@ -189,31 +189,31 @@ static void modes_and_defaults(void) {
   const char *args[] = {"--socket-mode", "0600", NULL};
   const char *envs[] = {env, NULL};
   pid_t pid = spawn(args, envs, -1, d.log);
-  CHECK(wait_ready(sock) == 0, "no socket at %s", sock);
-  CHECK(mode_of(sock) == 0600, "mode %o, want 0600", mode_of(sock));
+  EXPECT_MSG(wait_ready(sock) == 0, "no socket at %s", sock);
+  EXPECT_MSG(mode_of(sock) == 0600, "mode %o, want 0600", mode_of(sock));
   check_job(sock, "default path");
   kill(pid, SIGTERM);
-  CHECK_EQ(wait_exit(pid, T_MS), 0);
-  CHECK(mode_of(sock) == 0, "socket left behind");
+  EXPECT_EQ(wait_exit(pid, T_MS), 0);
+  EXPECT_MSG(mode_of(sock) == 0, "socket left behind");
 
   /* The command line. */
   const char *help[] = {"--help", NULL};
   pid = spawn(help, NULL, -1, d.log);
-  CHECK_EQ(wait_exit(pid, T_MS), 0);
+  EXPECT_EQ(wait_exit(pid, T_MS), 0);
   const char *bad[] = {"--workers", "0", NULL};
   pid = spawn(bad, NULL, -1, d.log);
-  CHECK_EQ(wait_exit(pid, T_MS), 2);
-  CHECK(scdt_log_contains(&d, "invalid --workers"), "no message");
+  EXPECT_EQ(wait_exit(pid, T_MS), 2);
+  EXPECT_MSG(scdt_log_contains(&d, "invalid --workers"), "no message");
   const char *unknown[] = {"--frobnicate", NULL};
   pid = spawn(unknown, NULL, -1, d.log);
-  CHECK_EQ(wait_exit(pid, T_MS), 2);
+  EXPECT_EQ(wait_exit(pid, T_MS), 2);
 }
 
 static void socket_activation(void) {
   scdt_daemon_t d;
-  REQUIRE(scdt_daemon_prepare(&d) == 0, "prepare");
+  ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
   int fd = bound_socket(d.sock, 1);
-  REQUIRE(fd >= 0, "bind");
+  ASSERT_MSG(fd >= 0, "bind");
   /* --socket names another path, which must be ignored. */
   char other[200];
   snprintf(other, sizeof other, "%s/other.sock", d.dir);
@@ -221,19 +221,19 @@ static void socket_activation(void) {
   pid_t pid = spawn(args, NULL, fd, d.log);
   close(fd);
   check_job(d.sock, "socket activation");
-  CHECK(mode_of(other) == 0, "bound --socket under socket activation");
+  EXPECT_MSG(mode_of(other) == 0, "bound --socket under socket activation");
   kill(pid, SIGTERM);
-  CHECK_EQ(wait_exit(pid, T_MS), 0);
+  EXPECT_EQ(wait_exit(pid, T_MS), 0);
   /* The socket is systemd's: it stays. */
-  CHECK(mode_of(d.sock) != 0, "removed the socket systemd owns");
-  CHECK(scdt_log_contains(&d, "using the socket systemd passed"),
-        "no log line");
+  EXPECT_MSG(mode_of(d.sock) != 0, "removed the socket systemd owns");
+  EXPECT_MSG(scdt_log_contains(&d, "using the socket systemd passed"),
+             "no log line");
   unlink(d.sock);
 }
 
 int main(int argc, char **argv) {
   scdt_init(argc, argv);
-  sphere = scdt_sample(SC_SURF_SPHERE, 2000, 5);
+  sphere = scdt_sample(SCS_SURF_SPHERE, 2000, 5);
   stale_and_second();
   not_a_socket_and_foreign();
   modes_and_defaults();

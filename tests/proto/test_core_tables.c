@@ -13,8 +13,12 @@
  */
 #include <ctype.h>
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
-#include "ptest.h"
+#include "scproto.h"
+#include "sct_assert.h"
 #include "shortcrust.h"
 
 /* Splits a markdown table row into at most max trimmed cells; returns the
@@ -69,17 +73,17 @@ static int check_option(char **c, int n) {
     if (strcmp(rows[i].name, c[0]) == 0)
       row = &rows[i];
   if (!row)
-    PT_FAIL_("PROTOCOL.md 6.3: option %s is not in SC_PARAM_MAP", c[0]);
-  CHECK_INT_EQ(row->wire, SC_PARAM_OPTION);
-  CHECK_STR_EQ(c[1], option_kind(row->kind));
+    ASSERT_FAIL("PROTOCOL.md 6.3: option %s is not in SC_PARAM_MAP", c[0]);
+  EXPECT_EQ(row->wire, SC_PARAM_OPTION);
+  EXPECT_STR_EQ(c[1], option_kind(row->kind));
   /* The table words a range for messages ("in (0, 10]", "0 or 1"). */
   const char *text = row->range_text;
   if (strncmp(text, "in ", 3) == 0)
     text += 3;
-  CHECK_STR_EQ(c[2], text);
+  EXPECT_STR_EQ(c[2], text);
   const char *open = strrchr(c[3], '(');
-  CHECK(open != NULL);
-  CHECK(fabs(spec_number(open + 1) - row->dflt) <= 1e-12 * fabs(row->dflt));
+  ASSERT_NOT_NULL(open);
+  EXPECT_NEAR(spec_number(open + 1), row->dflt, 1e-12 * fabs(row->dflt));
   return 1;
 }
 
@@ -109,7 +113,7 @@ static void expected_diagnostics(wire_names_t *w) {
   w->count = 0;
   for (size_t r = 0; r < count; ++r) {
     for (size_t i = 0; i < rows[r].count; ++i) {
-      CHECK(w->count < 62);
+      ASSERT_LT(w->count, 62);
       const char *suffix = sc_diag_element_name(&rows[r], i);
       if (suffix)
         snprintf(w->name[w->count], sizeof w->name[0], "%s.%s", rows[r].wire,
@@ -129,7 +133,7 @@ static void expected_diagnostics(wire_names_t *w) {
 static void check_document(const char *path) {
   FILE *fp = fopen(path, "r");
   if (!fp)
-    PT_FAIL_("cannot open %s", path);
+    ASSERT_FAIL("cannot open %s", path);
   wire_names_t want;
   expected_diagnostics(&want);
   char line[512], section[sizeof line] = "";
@@ -147,9 +151,9 @@ static void check_document(const char *path) {
     if (strncmp(section, "### 6.3", 7) == 0) {
       options += check_option(c, n);
     } else if (strncmp(section, "### 6.12", 8) == 0 && named_row(c, n)) {
-      CHECK(diags < want.count);
-      CHECK_STR_EQ(c[0], want.name[diags]);
-      CHECK_STR_EQ(c[1], want.kind[diags]);
+      ASSERT_LT(diags, want.count);
+      EXPECT_STR_EQ(c[0], want.name[diags]);
+      EXPECT_STR_EQ(c[1], want.kind[diags]);
       diags++;
     } else if (strncmp(section, "## 4.", 5) == 0 && n >= 2 &&
                isdigit((unsigned char)c[0][0])) {
@@ -166,10 +170,10 @@ static void check_document(const char *path) {
   const sc_param_info_t *rows = sc_param_table(&count);
   for (size_t i = 0; i < count; ++i)
     want_options += rows[i].wire == SC_PARAM_OPTION;
-  CHECK_U64_EQ(options, want_options);
-  CHECK_U64_EQ(diags, want.count);
-  CHECK_INT_EQ(modes, SC_MODE_COUNT_);
-  CHECK_INT_EQ(stages, SC_STAGE_COUNT);
+  EXPECT_EQ(options, want_options);
+  EXPECT_EQ(diags, want.count);
+  EXPECT_EQ(modes, SC_MODE_COUNT_);
+  EXPECT_EQ(stages, SC_STAGE_COUNT);
 }
 
 int main(int argc, char **argv) {
@@ -178,6 +182,5 @@ int main(int argc, char **argv) {
     return 2;
   }
   check_document(argv[1]);
-  pt_done("proto_core_tables");
-  return 0;
+  return sct_finish("proto_core_tables");
 }

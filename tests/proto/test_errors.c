@@ -10,7 +10,7 @@
  */
 #include <math.h>
 
-#include "ptest.h"
+#include "frames.h"
 
 static scp_decoder_t *decoder(int role, uint32_t max_frame) {
   scp_limits_t lim;
@@ -18,7 +18,7 @@ static scp_decoder_t *decoder(int role, uint32_t max_frame) {
   lim.role = role;
   lim.max_frame = max_frame;
   scp_decoder_t *d = scp_decoder_new(&lim);
-  CHECK(d != NULL);
+  ASSERT_NOT_NULL(d);
   return d;
 }
 
@@ -28,32 +28,32 @@ static void check_sticky(scp_decoder_t *d, int code) {
   uint8_t ping[16];
   pt_header(ping, SCP_PING, 0, 8);
   memset(ping + 8, 0, 8);
-  CHECK_RC(scp_decoder_error(d), code);
-  CHECK_RC(scp_decoder_next(d, &f), code);
-  CHECK_RC(scp_decoder_feed(d, ping, sizeof ping), code);
-  CHECK_RC(scp_decoder_next(d, &f), code);
-  CHECK_RC(scp_decoder_eof(d), code);
-  CHECK_RC(scp_decoder_error(d), code);
+  ASSERT_CODE_EQ(scp_decoder_error(d), code, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), code, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, ping, sizeof ping), code, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), code, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_eof(d), code, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_error(d), code, scp_err_name);
 }
 
 static void test_truncation(void) {
   scp_buf_t b;
   scp_buf_init(&b, 0);
-  CHECK_RC(scp_enc_ping(&b, 1), 0);
-  CHECK_RC(scp_enc_ping(&b, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_ping(&b, 1), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_ping(&b, 2), 0, scp_err_name);
   /* The stream may end after any whole frame, and at no other point. */
   for (size_t cut = 0; cut <= b.len; cut++) {
     scp_decoder_t *d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
     scp_frame_t f;
-    CHECK_RC(scp_decoder_feed(d, b.data, cut), 0);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, cut), 0, scp_err_name);
     int frames = 0, rc;
     while ((rc = scp_decoder_next(d, &f)) == 1)
       frames++;
     /* Missing bytes are not an error until the stream ends. */
-    CHECK_RC(rc, 0);
-    CHECK_INT_EQ(frames, (int)(cut / 16));
+    ASSERT_CODE_EQ(rc, 0, scp_err_name);
+    ASSERT_EQ(frames, (int)(cut / 16));
     int want = cut % 16 == 0 ? 0 : SCP_ETRUNCATED;
-    CHECK_RC(scp_decoder_eof(d), want);
+    ASSERT_CODE_EQ(scp_decoder_eof(d), want, scp_err_name);
     if (want)
       check_sticky(d, want);
     scp_decoder_free(d);
@@ -65,15 +65,15 @@ static void test_truncation(void) {
   memset(ign + 8, 0, 10);
   scp_decoder_t *d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
   scp_frame_t f;
-  CHECK_RC(scp_decoder_feed(d, ign, 12), 0);
-  CHECK_RC(scp_decoder_next(d, &f), 0);
-  CHECK_U64_EQ(scp_decoder_pending(d), 0); /* dropped, not buffered */
-  CHECK_RC(scp_decoder_eof(d), SCP_ETRUNCATED);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, ign, 12), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 0, scp_err_name);
+  ASSERT_EQ(scp_decoder_pending(d), 0); /* dropped, not buffered */
+  ASSERT_CODE_EQ(scp_decoder_eof(d), SCP_ETRUNCATED, scp_err_name);
   scp_decoder_free(d);
   d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, ign, sizeof ign), 0);
-  CHECK_RC(scp_decoder_next(d, &f), 0);
-  CHECK_RC(scp_decoder_eof(d), 0);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, ign, sizeof ign), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_eof(d), 0, scp_err_name);
   scp_decoder_free(d);
   scp_buf_free(&b);
 }
@@ -87,14 +87,14 @@ static void test_oversize(void) {
   for (int i = 0; i < 2; i++) {
     scp_decoder_t *d = decoder(SCP_ROLE_ANY, limits[i]);
     pt_header(h, SCP_POINTS, 0, limits[i] - SCP_HEADER_SIZE);
-    CHECK_RC(scp_decoder_feed(d, h, sizeof h), 0);
-    CHECK_RC(scp_decoder_next(d, &f), 0);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, h, sizeof h), 0, scp_err_name);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), 0, scp_err_name);
     scp_decoder_free(d);
 
     d = decoder(SCP_ROLE_ANY, limits[i]);
     pt_header(h, SCP_POINTS, 0, limits[i] - SCP_HEADER_SIZE + 1);
-    CHECK_RC(scp_decoder_feed(d, h, sizeof h), 0);
-    CHECK_RC(scp_decoder_next(d, &f), SCP_ETOOBIG);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, h, sizeof h), 0, scp_err_name);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_ETOOBIG, scp_err_name);
     check_sticky(d, SCP_ETOOBIG);
     scp_decoder_free(d);
   }
@@ -104,41 +104,43 @@ static void test_oversize(void) {
   for (int i = 0; i < 3; i++) {
     scp_decoder_t *d = decoder(SCP_ROLE_ANY, SCP_FRAME_CEILING);
     pt_header(h, SCP_TRIANGLES, 0, huge[i]);
-    CHECK_RC(scp_decoder_feed(d, h, sizeof h), 0);
-    CHECK_RC(scp_decoder_next(d, &f), SCP_ETOOBIG);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, h, sizeof h), 0, scp_err_name);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_ETOOBIG, scp_err_name);
     scp_decoder_free(d);
   }
 
   /* Ignorable frames obey the limit too. */
   scp_decoder_t *d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
   pt_header(h, 0x8001, 0, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, h, sizeof h), 0);
-  CHECK_RC(scp_decoder_next(d, &f), SCP_ETOOBIG);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, h, sizeof h), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_ETOOBIG, scp_err_name);
   scp_decoder_free(d);
 
   /* A limit lowered before the header is judged applies to it. */
   d = decoder(SCP_ROLE_ANY, 1u << 20);
   pt_header(h, SCP_POINTS, 0, 5000);
-  CHECK_RC(scp_decoder_feed(d, h, sizeof h), 0);
-  CHECK_RC(scp_decoder_set_max_frame(d, SCP_FRAME_MIN), 0);
-  CHECK_RC(scp_decoder_next(d, &f), SCP_ETOOBIG);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, h, sizeof h), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_set_max_frame(d, SCP_FRAME_MIN), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_ETOOBIG, scp_err_name);
   scp_decoder_free(d);
 
   /* Limits outside the protocol's range are refused. */
   d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_set_max_frame(d, SCP_FRAME_MIN - 1), SCP_EINVAL);
-  CHECK_RC(scp_decoder_set_max_frame(d, SCP_FRAME_CEILING + 1), SCP_EINVAL);
-  CHECK_U64_EQ(scp_decoder_max_frame(d), SCP_FRAME_MIN);
+  ASSERT_CODE_EQ(scp_decoder_set_max_frame(d, SCP_FRAME_MIN - 1), SCP_EINVAL,
+                 scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_set_max_frame(d, SCP_FRAME_CEILING + 1),
+                 SCP_EINVAL, scp_err_name);
+  ASSERT_EQ(scp_decoder_max_frame(d), SCP_FRAME_MIN);
   scp_decoder_free(d);
   scp_limits_t lim;
   scp_limits_init(&lim);
   lim.max_frame = SCP_FRAME_MIN - 1;
-  CHECK(scp_decoder_new(&lim) == NULL);
+  ASSERT_NULL(scp_decoder_new(&lim));
   lim.max_frame = SCP_FRAME_CEILING + 1;
-  CHECK(scp_decoder_new(&lim) == NULL);
+  ASSERT_NULL(scp_decoder_new(&lim));
   scp_limits_init(&lim);
   lim.role = 3;
-  CHECK(scp_decoder_new(&lim) == NULL);
+  ASSERT_NULL(scp_decoder_new(&lim));
 
   /* The encoder will not write a frame over its limit either. */
   scp_buf_t b;
@@ -146,9 +148,9 @@ static void test_oversize(void) {
   scp_value_t v[400];
   for (int i = 0; i < 400; i++)
     v[i] = (scp_value_t){.name = "abc", .kind = SCP_KIND_U64, .v.u = 1};
-  CHECK_RC(scp_enc_stats(&b, 1, v, 400), SCP_ETOOBIG);
-  CHECK_U64_EQ(b.len, 0);
-  CHECK_RC(scp_enc_stats(&b, 1, v, 300), 0);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 1, v, 400), SCP_ETOOBIG, scp_err_name);
+  ASSERT_EQ(b.len, 0);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 1, v, 300), 0, scp_err_name);
   scp_buf_free(&b);
 }
 
@@ -159,8 +161,8 @@ static void test_header_flags(void) {
     scp_decoder_t *d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
     pt_header(h, SCP_PING, (uint16_t)(1u << bit), 8);
     memset(h + 8, 0, 8);
-    CHECK_RC(scp_decoder_feed(d, h, sizeof h), 0);
-    CHECK_RC(scp_decoder_next(d, &f), SCP_ERESERVED);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, h, sizeof h), 0, scp_err_name);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_ERESERVED, scp_err_name);
     check_sticky(d, SCP_ERESERVED);
     scp_decoder_free(d);
   }
@@ -170,7 +172,7 @@ static void test_magic_and_version(void) {
   scp_buf_t b;
   scp_buf_init(&b, 0);
   scp_hello_t h = {.version_min = 1, .version_max = 1, .max_frame = 4096};
-  CHECK_RC(scp_enc_hello(&b, &h), 0);
+  ASSERT_CODE_EQ(scp_enc_hello(&b, &h), 0, scp_err_name);
   /* Any change to the magic is caught as soon as the magic is in, before
    * the rest of the frame arrives. */
   for (int i = 0; i < SCP_MAGIC_LEN; i++) {
@@ -179,36 +181,38 @@ static void test_magic_and_version(void) {
     bad[8 + i] ^= 0x20;
     scp_decoder_t *d = decoder(SCP_ROLE_SERVER, SCP_FRAME_MIN);
     scp_frame_t f;
-    CHECK_RC(scp_decoder_feed(d, bad, 8 + SCP_MAGIC_LEN - 1), 0);
-    CHECK_RC(scp_decoder_next(d, &f), 0);
-    CHECK_RC(scp_decoder_feed(d, bad + 11, 1), 0);
-    CHECK_RC(scp_decoder_next(d, &f), SCP_EBADMAGIC);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, bad, 8 + SCP_MAGIC_LEN - 1), 0,
+                   scp_err_name);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), 0, scp_err_name);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, bad + 11, 1), 0, scp_err_name);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EBADMAGIC, scp_err_name);
     check_sticky(d, SCP_EBADMAGIC);
     scp_decoder_free(d);
 
     /* The parser says the same of a frame it is handed directly. */
     f = (scp_frame_t){.type = SCP_HELLO, .length = 24, .payload = bad + 8};
     scp_hello_t out;
-    CHECK_RC(scp_parse_hello(&f, &out), SCP_EBADMAGIC);
+    ASSERT_CODE_EQ(scp_parse_hello(&f, &out), SCP_EBADMAGIC, scp_err_name);
   }
   scp_buf_consume(&b, b.len);
 
   /* WELCOME's magic is checked in the client role too. */
   scp_welcome_t w = {.version = 1, .max_frame = 4096, .max_jobs = 1,
                      .max_points = 1};
-  CHECK_RC(scp_enc_welcome(&b, &w), 0);
+  ASSERT_CODE_EQ(scp_enc_welcome(&b, &w), 0, scp_err_name);
   b.data[8] = 'X';
   scp_decoder_t *d = decoder(SCP_ROLE_CLIENT, SCP_FRAME_MIN);
   scp_frame_t f;
-  CHECK_RC(scp_decoder_feed(d, b.data, b.len), 0);
-  CHECK_RC(scp_decoder_next(d, &f), SCP_EBADMAGIC);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EBADMAGIC, scp_err_name);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   /* A peer speaking HTTP: "GET / HTTP/1.1" is no handshake at all. */
   d = decoder(SCP_ROLE_SERVER, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, "GET / HTTP/1.1\r\n", 16), 0);
-  CHECK_RC(scp_decoder_next(d, &f), SCP_EHANDSHAKE);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, "GET / HTTP/1.1\r\n", 16), 0,
+                 scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EHANDSHAKE, scp_err_name);
   scp_decoder_free(d);
 
   /* Version fields: an empty or zero range in HELLO, and a WELCOME naming
@@ -218,8 +222,8 @@ static void test_magic_and_version(void) {
       {.version_min = 2, .version_max = 1, .max_frame = 4096},
       {.version_min = 0, .version_max = 0, .max_frame = 4096}};
   for (int i = 0; i < 3; i++) {
-    CHECK_RC(scp_enc_hello(&b, &bad_h[i]), SCP_EVERSION);
-    CHECK_U64_EQ(b.len, 0);
+    ASSERT_CODE_EQ(scp_enc_hello(&b, &bad_h[i]), SCP_EVERSION, scp_err_name);
+    ASSERT_EQ(b.len, 0);
     uint8_t raw[32];
     pt_header(raw, SCP_HELLO, 0, 24);
     memset(raw + 8, 0, 24);
@@ -229,7 +233,7 @@ static void test_magic_and_version(void) {
     pt_put32(raw + 24, 4096);
     f = (scp_frame_t){.type = SCP_HELLO, .length = 24, .payload = raw + 8};
     scp_hello_t out;
-    CHECK_RC(scp_parse_hello(&f, &out), SCP_EVERSION);
+    ASSERT_CODE_EQ(scp_parse_hello(&f, &out), SCP_EVERSION, scp_err_name);
   }
   uint8_t raw[40];
   pt_header(raw, SCP_WELCOME, 0, 32);
@@ -241,36 +245,39 @@ static void test_magic_and_version(void) {
   pt_put64(raw + 32, 1);
   f = (scp_frame_t){.type = SCP_WELCOME, .length = 32, .payload = raw + 8};
   scp_welcome_t wout;
-  CHECK_RC(scp_parse_welcome(&f, &wout), SCP_EVERSION);
+  ASSERT_CODE_EQ(scp_parse_welcome(&f, &wout), SCP_EVERSION, scp_err_name);
   raw[12] = 1;
-  CHECK_RC(scp_parse_welcome(&f, &wout), 0);
+  ASSERT_CODE_EQ(scp_parse_welcome(&f, &wout), 0, scp_err_name);
 
   /* Negotiation: a client offering only versions 2 to 5 gets VERSION. */
   scp_hello_t later = {.version_min = 2, .version_max = 5, .max_frame = 4096};
   scp_welcome_t server = {.max_frame = 1u << 20, .max_jobs = 1,
                           .max_points = 1};
   scp_welcome_t ans;
-  CHECK_RC(scp_handshake_answer(&later, &server, &ans), SCP_EVERSION);
-  CHECK_U64_EQ(scp_err_to_wire(SCP_EVERSION), SCP_WIRE_VERSION);
+  ASSERT_CODE_EQ(scp_handshake_answer(&later, &server, &ans), SCP_EVERSION,
+                 scp_err_name);
+  ASSERT_EQ(scp_err_to_wire(SCP_EVERSION), SCP_WIRE_VERSION);
   scp_hello_t tiny = {.version_min = 1, .version_max = 1, .max_frame = 4095};
-  CHECK_RC(scp_handshake_answer(&tiny, &server, &ans), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_handshake_answer(&tiny, &server, &ans), SCP_ERANGE,
+                 scp_err_name);
   server.max_frame = SCP_FRAME_CEILING + 1;
-  CHECK_RC(scp_handshake_answer(&h, &server, &ans), SCP_EINVAL);
+  ASSERT_CODE_EQ(scp_handshake_answer(&h, &server, &ans), SCP_EINVAL,
+                 scp_err_name);
 
   /* The client's checks of WELCOME against its HELLO. */
   scp_hello_t sent = {.version_min = 1, .version_max = 1, .features = 0x2,
                       .max_frame = 1u << 16};
   scp_welcome_t got = {.version = 1, .features = 0x2, .max_frame = 1u << 16,
                        .max_jobs = 1, .max_points = 1};
-  CHECK_RC(scp_handshake_check(&sent, &got), 0);
+  ASSERT_CODE_EQ(scp_handshake_check(&sent, &got), 0, scp_err_name);
   got.max_frame = (1u << 16) + 1;
-  CHECK_RC(scp_handshake_check(&sent, &got), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_handshake_check(&sent, &got), SCP_ERANGE, scp_err_name);
   got.max_frame = 1u << 16;
   got.features = 0x3;
-  CHECK_RC(scp_handshake_check(&sent, &got), SCP_EFLAGS);
+  ASSERT_CODE_EQ(scp_handshake_check(&sent, &got), SCP_EFLAGS, scp_err_name);
   got.features = 0;
   got.max_jobs = 0;
-  CHECK_RC(scp_handshake_check(&sent, &got), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_handshake_check(&sent, &got), SCP_ERANGE, scp_err_name);
   scp_buf_free(&b);
 }
 
@@ -283,10 +290,10 @@ static void test_handshake_position(void) {
                      .max_points = 1};
 
   /* Server role: the first frame must be HELLO... */
-  CHECK_RC(scp_enc_ping(&b, 1), 0);
+  ASSERT_CODE_EQ(scp_enc_ping(&b, 1), 0, scp_err_name);
   scp_decoder_t *d = decoder(SCP_ROLE_SERVER, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, b.data, b.len), 0);
-  CHECK_RC(scp_decoder_next(d, &f), SCP_EHANDSHAKE);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EHANDSHAKE, scp_err_name);
   check_sticky(d, SCP_EHANDSHAKE);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
@@ -295,26 +302,26 @@ static void test_handshake_position(void) {
   uint8_t ign[8];
   pt_header(ign, 0x8001, 0, 0);
   d = decoder(SCP_ROLE_SERVER, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, ign, sizeof ign), 0);
-  CHECK_RC(scp_decoder_next(d, &f), SCP_EHANDSHAKE);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, ign, sizeof ign), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EHANDSHAKE, scp_err_name);
   scp_decoder_free(d);
 
   /* ...and HELLO or WELCOME may not come again. */
   uint16_t again[2] = {SCP_HELLO, SCP_WELCOME};
   for (int i = 0; i < 2; i++) {
-    CHECK_RC(scp_enc_hello(&b, &h), 0);
-    CHECK_RC(scp_enc_ping(&b, 1), 0);
+    ASSERT_CODE_EQ(scp_enc_hello(&b, &h), 0, scp_err_name);
+    ASSERT_CODE_EQ(scp_enc_ping(&b, 1), 0, scp_err_name);
     if (again[i] == SCP_HELLO)
-      CHECK_RC(scp_enc_hello(&b, &h), 0);
+      ASSERT_CODE_EQ(scp_enc_hello(&b, &h), 0, scp_err_name);
     else
-      CHECK_RC(scp_enc_welcome(&b, &w), 0);
+      ASSERT_CODE_EQ(scp_enc_welcome(&b, &w), 0, scp_err_name);
     d = decoder(SCP_ROLE_SERVER, SCP_FRAME_MIN);
-    CHECK_RC(scp_decoder_feed(d, b.data, b.len), 0);
-    CHECK_RC(scp_decoder_next(d, &f), 1);
-    CHECK_INT_EQ(f.type, SCP_HELLO);
-    CHECK_RC(scp_decoder_next(d, &f), 1);
-    CHECK_INT_EQ(f.type, SCP_PING);
-    CHECK_RC(scp_decoder_next(d, &f), SCP_EHANDSHAKE);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+    ASSERT_EQ(f.type, SCP_HELLO);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+    ASSERT_EQ(f.type, SCP_PING);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EHANDSHAKE, scp_err_name);
     scp_decoder_free(d);
     scp_buf_consume(&b, b.len);
   }
@@ -322,34 +329,35 @@ static void test_handshake_position(void) {
   /* Client role: WELCOME, or a fatal ERROR instead of it. */
   scp_error_t e = {.code = SCP_WIRE_VERSION, .flags = SCP_ERROR_FATAL};
   strcpy(e.message, "server speaks versions 1 to 1");
-  CHECK_RC(scp_enc_error(&b, &e), 0);
+  ASSERT_CODE_EQ(scp_enc_error(&b, &e), 0, scp_err_name);
   d = decoder(SCP_ROLE_CLIENT, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, b.data, b.len), 0);
-  CHECK_RC(scp_decoder_next(d, &f), 1);
-  CHECK_INT_EQ(f.type, SCP_ERROR);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, SCP_ERROR);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
-  CHECK_RC(scp_enc_hello(&b, &h), 0);
+  ASSERT_CODE_EQ(scp_enc_hello(&b, &h), 0, scp_err_name);
   d = decoder(SCP_ROLE_CLIENT, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, b.data, b.len), 0);
-  CHECK_RC(scp_decoder_next(d, &f), SCP_EHANDSHAKE);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EHANDSHAKE, scp_err_name);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
-  CHECK_RC(scp_enc_accepted(&b, &(scp_accepted_t){.job_id = 1}), 0);
+  ASSERT_CODE_EQ(scp_enc_accepted(&b, &(scp_accepted_t){.job_id = 1}), 0,
+                 scp_err_name);
   d = decoder(SCP_ROLE_CLIENT, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, b.data, b.len), 0);
-  CHECK_RC(scp_decoder_next(d, &f), SCP_EHANDSHAKE);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EHANDSHAKE, scp_err_name);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
-  CHECK_RC(scp_enc_welcome(&b, &w), 0);
-  CHECK_RC(scp_enc_welcome(&b, &w), 0);
+  ASSERT_CODE_EQ(scp_enc_welcome(&b, &w), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_welcome(&b, &w), 0, scp_err_name);
   d = decoder(SCP_ROLE_CLIENT, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, b.data, b.len), 0);
-  CHECK_RC(scp_decoder_next(d, &f), 1);
-  CHECK_RC(scp_decoder_next(d, &f), SCP_EHANDSHAKE);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EHANDSHAKE, scp_err_name);
   scp_decoder_free(d);
   scp_buf_free(&b);
 }
@@ -365,36 +373,38 @@ static void test_unknown_type(void) {
   scp_decoder_t *d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
   scp_frame_t f;
   scp_msg_t m;
-  CHECK_RC(scp_decoder_feed(d, s, sizeof s), 0);
-  CHECK_RC(scp_decoder_next(d, &f), 1);
-  CHECK_INT_EQ(f.type, 0x0099);
-  CHECK_RC(scp_parse(&f, &m), SCP_EUNKNOWN_TYPE);
-  CHECK_INT_EQ(m.type, 0x0099);
-  CHECK_U64_EQ(scp_err_to_wire(SCP_EUNKNOWN_TYPE), SCP_WIRE_UNKNOWN_TYPE);
-  CHECK_INT_EQ(scp_err_is_fatal(SCP_EUNKNOWN_TYPE), 0);
-  CHECK_RC(scp_decoder_next(d, &f), 1);
-  CHECK_INT_EQ(f.type, SCP_PING);
-  CHECK_RC(scp_decoder_next(d, &f), 0);
-  CHECK_RC(scp_decoder_error(d), 0);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, s, sizeof s), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, 0x0099);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_EUNKNOWN_TYPE, scp_err_name);
+  ASSERT_EQ(m.type, 0x0099);
+  ASSERT_EQ(scp_err_to_wire(SCP_EUNKNOWN_TYPE), SCP_WIRE_UNKNOWN_TYPE);
+  ASSERT_EQ(scp_err_is_fatal(SCP_EUNKNOWN_TYPE), 0);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, SCP_PING);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_error(d), 0, scp_err_name);
   scp_decoder_free(d);
 
   /* Type 0 is never used. */
   f = (scp_frame_t){.type = 0, .length = 0, .payload = s};
-  CHECK_RC(scp_parse(&f, &m), SCP_EUNKNOWN_TYPE);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_EUNKNOWN_TYPE, scp_err_name);
 
   /* A frame travelling the wrong way is an unknown type for its receiver,
    * whatever its payload (here even a malformed one). */
   uint8_t tri[24];
   memset(tri, 0xff, sizeof tri);
   f = (scp_frame_t){.type = SCP_TRIANGLES, .length = 24, .payload = tri};
-  CHECK_RC(scp_parse_as(&f, SCP_ROLE_SERVER, &m), SCP_EUNKNOWN_TYPE);
-  CHECK_RC(scp_parse(&f, &m), SCP_ERESERVED);
+  ASSERT_CODE_EQ(scp_parse_as(&f, SCP_ROLE_SERVER, &m), SCP_EUNKNOWN_TYPE,
+                 scp_err_name);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ERESERVED, scp_err_name);
   f.type = SCP_POINTS;
-  CHECK_RC(scp_parse_as(&f, SCP_ROLE_CLIENT, &m), SCP_EUNKNOWN_TYPE);
+  ASSERT_CODE_EQ(scp_parse_as(&f, SCP_ROLE_CLIENT, &m), SCP_EUNKNOWN_TYPE,
+                 scp_err_name);
   uint8_t ping[8] = {0};
   f = (scp_frame_t){.type = SCP_PING, .length = 8, .payload = ping};
-  CHECK_RC(scp_parse_as(&f, SCP_ROLE_CLIENT, &m), 0);
-  CHECK_RC(scp_parse_as(&f, SCP_ROLE_SERVER, &m), 0);
+  ASSERT_CODE_EQ(scp_parse_as(&f, SCP_ROLE_CLIENT, &m), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_parse_as(&f, SCP_ROLE_SERVER, &m), 0, scp_err_name);
 
   /* Ignorable types are dropped and counted, never returned. */
   uint8_t ign[8 + 5 + 16];
@@ -403,13 +413,13 @@ static void test_unknown_type(void) {
   pt_header(ign + 13, SCP_PONG, 0, 8);
   memset(ign + 21, 2, 8);
   d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, ign, sizeof ign), 0);
-  CHECK_RC(scp_decoder_next(d, &f), 1);
-  CHECK_INT_EQ(f.type, SCP_PONG);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, ign, sizeof ign), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, SCP_PONG);
   scp_decoder_counters_t c;
   scp_decoder_get_counters(d, &c);
-  CHECK_U64_EQ(c.skipped, 1);
-  CHECK_U64_EQ(c.frames, 1);
+  ASSERT_EQ(c.skipped, 1);
+  ASSERT_EQ(c.frames, 1);
   scp_decoder_free(d);
 }
 
@@ -428,8 +438,8 @@ static raw_t encoded(int (*enc)(scp_buf_t *, const void *), const void *m) {
   scp_buf_t b;
   scp_buf_init(&b, 0);
   raw_t r;
-  CHECK_RC(enc(&b, m), 0);
-  CHECK(b.len - SCP_HEADER_SIZE <= sizeof r.p);
+  ASSERT_CODE_EQ(enc(&b, m), 0, scp_err_name);
+  ASSERT_LE(b.len - SCP_HEADER_SIZE, sizeof r.p);
   r.len = (uint32_t)(b.len - SCP_HEADER_SIZE);
   memcpy(r.p, b.data + SCP_HEADER_SIZE, r.len);
   scp_buf_free(&b);
@@ -474,13 +484,13 @@ static void test_wrong_lengths(void) {
   for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++) {
     scp_frame_t f = {.type = fixed[i].type, .payload = zero};
     f.length = fixed[i].size - 1;
-    CHECK_RC(scp_parse(&f, &m), SCP_ESHORT);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ESHORT, scp_err_name);
     f.length = 0;
-    CHECK_RC(scp_parse(&f, &m), SCP_ESHORT);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ESHORT, scp_err_name);
     f.length = fixed[i].size + 1;
-    CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
-    CHECK_INT_EQ(scp_err_is_fatal(SCP_ESHORT), 1);
-    CHECK_INT_EQ(scp_err_is_fatal(SCP_ELENGTH), 1);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
+    ASSERT_EQ(scp_err_is_fatal(SCP_ESHORT), 1);
+    ASSERT_EQ(scp_err_is_fatal(SCP_ELENGTH), 1);
   }
   /* Fixed parts of the variable messages. */
   static const struct {
@@ -495,7 +505,7 @@ static void test_wrong_lengths(void) {
   for (size_t i = 0; i < sizeof var / sizeof var[0]; i++) {
     scp_frame_t f = {.type = var[i].type, .payload = hs};
     f.length = var[i].size - 1;
-    CHECK_RC(scp_parse(&f, &m), SCP_ESHORT);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ESHORT, scp_err_name);
   }
 
   /* JOB_BEGIN with job options: 41 to 47 bytes malformed; a list that
@@ -505,43 +515,43 @@ static void test_wrong_lengths(void) {
     scp_job_begin_t jb = {.job_id = 2, .r = 0.2};
     scp_buf_t ob;
     scp_buf_init(&ob, 0);
-    CHECK_RC(scp_enc_job_begin_options(&ob, &jb, &o, 1), 0);
+    ASSERT_CODE_EQ(scp_enc_job_begin_options(&ob, &jb, &o, 1), 0, scp_err_name);
     scp_frame_t g = {.type = SCP_JOB_BEGIN,
                      .payload = ob.data + SCP_HEADER_SIZE,
                      .length = (uint32_t)(ob.len - SCP_HEADER_SIZE)};
-    CHECK_RC(scp_parse(&g, &m), 0);
+    ASSERT_CODE_EQ(scp_parse(&g, &m), 0, scp_err_name);
     /* Without the JOB_OPTIONS feature, anything past the fixed part is
      * malformed however it reads; with it, the same as scp_parse(). */
     scp_job_begin_t jm;
-    CHECK_RC(scp_parse_job_begin_features(&g, SCP_FEATURE_JOB_OPTIONS, &jm),
-             0);
-    CHECK_U64_EQ(jm.options.count, 1);
-    CHECK_RC(scp_parse_job_begin_features(&g, 0, &jm), SCP_ELENGTH);
+    ASSERT_CODE_EQ(scp_parse_job_begin_features(&g, SCP_FEATURE_JOB_OPTIONS, &jm),
+             0, scp_err_name);
+    ASSERT_EQ(jm.options.count, 1);
+    ASSERT_CODE_EQ(scp_parse_job_begin_features(&g, 0, &jm), SCP_ELENGTH, scp_err_name);
     g.length = SCP_JOB_BEGIN_FIXED;
-    CHECK_RC(scp_parse_job_begin_features(&g, 0, &jm), 0);
-    CHECK_U64_EQ(jm.options.count, 0);
+    ASSERT_CODE_EQ(scp_parse_job_begin_features(&g, 0, &jm), 0, scp_err_name);
+    ASSERT_EQ(jm.options.count, 0);
     g.length = (uint32_t)(ob.len - SCP_HEADER_SIZE);
     for (uint32_t n = 41; n < 48; n++) {
       g.length = n;
-      CHECK_RC(scp_parse(&g, &m), SCP_ELENGTH);
+      ASSERT_CODE_EQ(scp_parse(&g, &m), SCP_ELENGTH, scp_err_name);
     }
     g.length = (uint32_t)(ob.len - SCP_HEADER_SIZE) - 1;
-    CHECK_RC(scp_parse(&g, &m), SCP_ELENGTH);
+    ASSERT_CODE_EQ(scp_parse(&g, &m), SCP_ELENGTH, scp_err_name);
     g.length = (uint32_t)(ob.len - SCP_HEADER_SIZE);
     pt_put32(ob.data + SCP_HEADER_SIZE + 40, 2);
-    CHECK_RC(scp_parse(&g, &m), SCP_ELENGTH);
+    ASSERT_CODE_EQ(scp_parse(&g, &m), SCP_ELENGTH, scp_err_name);
     pt_put32(ob.data + SCP_HEADER_SIZE + 44, 1);
     pt_put32(ob.data + SCP_HEADER_SIZE + 40, 1);
-    CHECK_RC(scp_parse(&g, &m), SCP_ERESERVED);
+    ASSERT_CODE_EQ(scp_parse(&g, &m), SCP_ERESERVED, scp_err_name);
     pt_put32(ob.data + SCP_HEADER_SIZE + 44, 0);
     g.length = 48;
     pt_put32(ob.data + SCP_HEADER_SIZE + 40, 0);
-    CHECK_RC(scp_parse(&g, &m), SCP_ERANGE);
-    CHECK_RC(scp_parse_job_begin_features(&g, 0, &jm), SCP_ELENGTH);
-    CHECK_INT_EQ(scp_err_is_fatal(SCP_ERANGE), 0);
+    ASSERT_CODE_EQ(scp_parse(&g, &m), SCP_ERANGE, scp_err_name);
+    ASSERT_CODE_EQ(scp_parse_job_begin_features(&g, 0, &jm), SCP_ELENGTH, scp_err_name);
+    ASSERT_EQ(scp_err_is_fatal(SCP_ERANGE), 0);
     /* The encoder refuses an empty view of options that claims entries. */
     jb.options = (scp_values_t){.count = 1, .data = NULL, .len = 0};
-    CHECK_RC(scp_enc_job_begin(&ob, &jb), SCP_EINVAL);
+    ASSERT_CODE_EQ(scp_enc_job_begin(&ob, &jb), SCP_EINVAL, scp_err_name);
     scp_buf_free(&ob);
   }
 
@@ -550,21 +560,21 @@ static void test_wrong_lengths(void) {
   strcpy(e.message, "abc");
   raw_t r = encoded(enc_error_, &e);
   scp_frame_t f = frame_of(SCP_ERROR, &r);
-  CHECK_RC(scp_parse(&f, &m), 0);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
   pt_put32(r.p + 16, 4);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   pt_put32(r.p + 16, 2);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   pt_put32(r.p + 16, 0xFFFFFFFFu);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
 
   scp_job_error_t je = {.job_id = 1, .code = SCP_WIRE_BUSY};
   strcpy(je.message, "abc");
   r = encoded(enc_job_error_, &je);
   f = frame_of(SCP_JOB_ERROR, &r);
-  CHECK_RC(scp_parse(&f, &m), 0);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
   pt_put32(r.p + 8, 0xFFFFFFF0u);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   /* And one that tells the truth about a payload longer than allowed. */
   uint8_t big[16 + SCP_MESSAGE_MAX + 1];
   memset(big, 'm', sizeof big);
@@ -574,63 +584,64 @@ static void test_wrong_lengths(void) {
   pt_put32(big + 12, 0);
   f = (scp_frame_t){.type = SCP_JOB_ERROR, .length = sizeof big,
                     .payload = big};
-  CHECK_RC(scp_parse(&f, &m), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ERANGE, scp_err_name);
   pt_put32(big + 8, SCP_MESSAGE_MAX);
   f.length--;
-  CHECK_RC(scp_parse(&f, &m), 0);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
 
   /* Chunks whose count does not match the data. */
   double xyz[6] = {0};
   scp_buf_t b;
   scp_buf_init(&b, 0);
-  CHECK_RC(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, xyz, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, xyz, 2), 0,
+                 scp_err_name);
   memcpy(r.p, b.data + 8, b.len - 8);
   r.len = (uint32_t)(b.len - 8);
   f = frame_of(SCP_POINTS, &r);
-  CHECK_RC(scp_parse(&f, &m), 0);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
   pt_put32(r.p + 4, 3);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   pt_put32(r.p + 4, 1);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   pt_put32(r.p + 4, 0xFFFFFFFFu);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   pt_put32(r.p + 4, 2);
   /* Same count, but the element size of the other format. */
   pt_put32(r.p + 16, SCP_F32_XYZ);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   pt_put32(r.p + 16, SCP_F64_XYZ);
   f.length--;
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   scp_buf_free(&b);
 
   /* Value lists whose count lies, or whose names run past the end. */
   scp_value_t v[2] = {{.name = "ab", .kind = SCP_KIND_U64, .v.u = 1},
                       {.name = "cd", .kind = SCP_KIND_U64, .v.u = 2}};
   scp_buf_init(&b, 0);
-  CHECK_RC(scp_enc_stats(&b, 1, v, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 1, v, 2), 0, scp_err_name);
   memcpy(r.p, b.data + 8, b.len - 8);
   r.len = (uint32_t)(b.len - 8);
   f = frame_of(SCP_STATS, &r);
-  CHECK_RC(scp_parse(&f, &m), 0);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
   pt_put32(r.p + 4, 3);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   pt_put32(r.p + 4, 1);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   pt_put32(r.p + 4, 0xFFFFFFFFu);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   pt_put32(r.p + 4, 2);
   r.p[8 + 12 + 1] = 200; /* second name_len */
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   r.p[8 + 12 + 1] = 2;
   f.length++;
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   f.length--;
   /* A bad name in a list that is also misframed is reported as misframed:
    * the stream cannot be trusted, which matters more. */
   r.p[8 + 2] = 'A';
-  CHECK_RC(scp_parse(&f, &m), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ERANGE, scp_err_name);
   pt_put32(r.p + 4, 3);
-  CHECK_RC(scp_parse(&f, &m), SCP_ELENGTH);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ELENGTH, scp_err_name);
   scp_buf_free(&b);
 
   /* HELLO and WELCOME may be longer: the tail is for later versions. */
@@ -639,13 +650,13 @@ static void test_wrong_lengths(void) {
   memset(r.p + r.len, 0xAB, 16);
   r.len += 16;
   f = frame_of(SCP_HELLO, &r);
-  CHECK_RC(scp_parse(&f, &m), 0);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
   scp_welcome_t w = {.version = 1, .max_frame = 4096, .max_jobs = 1,
                      .max_points = 1};
   r = encoded(enc_welcome_, &w);
   r.len += 100;
   f = frame_of(SCP_WELCOME, &r);
-  CHECK_RC(scp_parse(&f, &m), 0);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
 }
 
 /* Every reserved field, one bit at a time. */
@@ -683,17 +694,17 @@ static void test_reserved(void) {
 
   for (int i = 0; i < n; i++) {
     scp_frame_t f = frame_of(cases[i].type, &cases[i].r);
-    CHECK_RC(scp_parse(&f, &m), 0);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
     for (uint32_t bit = 0; bit < 8 * cases[i].width; bit++) {
       uint8_t *p = cases[i].r.p + cases[i].off + bit / 8;
       *p ^= (uint8_t)(1u << (bit % 8));
       int rc = scp_parse(&f, &m);
       if (rc != SCP_ERESERVED)
-        PT_FAIL_("%s: reserved bit %u gives %s", scp_type_name(cases[i].type),
-                 bit, scp_err_name(rc));
+        ASSERT_FAIL("%s: reserved bit %u gives %s",
+                    scp_type_name(cases[i].type), bit, scp_err_name(rc));
       *p ^= (uint8_t)(1u << (bit % 8));
     }
-    CHECK_RC(scp_parse(&f, &m), 0);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
   }
 
   /* The chunk frames' reserved word. */
@@ -708,12 +719,12 @@ static void test_reserved(void) {
     scp_frame_t f = {.type = chunk_types[i],
                      .length = (uint32_t)(24 + scp_format_size(formats[i])),
                      .payload = p};
-    CHECK_RC(scp_parse(&f, &m), 0);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), 0, scp_err_name);
     p[23] = 0x80;
-    CHECK_RC(scp_parse(&f, &m), SCP_ERESERVED);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ERESERVED, scp_err_name);
   }
-  CHECK_INT_EQ(scp_err_is_fatal(SCP_ERESERVED), 1);
-  CHECK_U64_EQ(scp_err_to_wire(SCP_ERESERVED), SCP_WIRE_PROTOCOL);
+  ASSERT_EQ(scp_err_is_fatal(SCP_ERESERVED), 1);
+  ASSERT_EQ(scp_err_to_wire(SCP_ERESERVED), SCP_WIRE_PROTOCOL);
 }
 
 /* A job frame that fails on a field still names its job (PROTOCOL.md 8.3),
@@ -724,13 +735,13 @@ static void expect_invalid(uint16_t type, const raw_t *r, int code,
   scp_msg_t m;
   int rc = scp_parse(&f, &m);
   if (rc != code)
-    PT_FAIL_("%s: got %s, expected %s", scp_type_name(type), scp_err_name(rc),
-             scp_err_name(code));
-  CHECK_INT_EQ(scp_err_is_fatal(rc), 0);
+    ASSERT_FAIL("%s: got %s, expected %s", scp_type_name(type),
+                scp_err_name(rc), scp_err_name(code));
+  ASSERT_EQ(scp_err_is_fatal(rc), 0);
   uint32_t id = 0;
   if (job) {
-    CHECK(scp_frame_job_id(&f, &id));
-    CHECK_U64_EQ(id, job);
+    ASSERT(scp_frame_job_id(&f, &id));
+    ASSERT_EQ(id, job);
   }
 }
 
@@ -788,8 +799,8 @@ static void test_ranges(void) {
     memcpy(&m.r, r.p + 8, 8);
     memcpy(&m.theta, r.p + 16, 8);
     m.flags = parsed.flags;
-    CHECK_RC(scp_enc_job_begin(&b, &m), jb_cases[i].code);
-    CHECK_U64_EQ(b.len, 0);
+    ASSERT_CODE_EQ(scp_enc_job_begin(&b, &m), jb_cases[i].code, scp_err_name);
+    ASSERT_EQ(b.len, 0);
   }
   /* Job id 0 names no job. */
   raw_t r = base;
@@ -801,17 +812,18 @@ static void test_ranges(void) {
 
   /* JOB_END, CANCEL and ACCEPTED with job 0. */
   scp_job_end_t jend = {.job_id = 0};
-  CHECK_RC(scp_enc_job_end(&b, &jend), SCP_ERANGE);
-  CHECK_RC(scp_enc_cancel(&b, 0), SCP_ERANGE);
-  CHECK_RC(scp_enc_accepted(&b, &(scp_accepted_t){.job_id = 0}), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_enc_job_end(&b, &jend), SCP_ERANGE, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_cancel(&b, 0), SCP_ERANGE, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_accepted(&b, &(scp_accepted_t){.job_id = 0}),
+                 SCP_ERANGE, scp_err_name);
   uint8_t z[16] = {0};
   scp_frame_t f = {.type = SCP_JOB_END, .length = 16, .payload = z};
   scp_msg_t m;
-  CHECK_RC(scp_parse(&f, &m), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ERANGE, scp_err_name);
   f = (scp_frame_t){.type = SCP_CANCEL, .length = 8, .payload = z};
-  CHECK_RC(scp_parse(&f, &m), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ERANGE, scp_err_name);
   f = (scp_frame_t){.type = SCP_ACCEPTED, .length = 8, .payload = z};
-  CHECK_RC(scp_parse(&f, &m), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ERANGE, scp_err_name);
 
   /* PROGRESS: stage and fraction. */
   scp_progress_t pr[] = {{.job_id = 1, .stage = SCP_STAGE_COUNT},
@@ -821,7 +833,7 @@ static void test_ranges(void) {
                          {.job_id = 1, .fraction = NAN},
                          {.job_id = 0, .fraction = 0.5}};
   for (size_t i = 0; i < sizeof pr / sizeof pr[0]; i++) {
-    CHECK_RC(scp_enc_progress(&b, &pr[i]), SCP_ERANGE);
+    ASSERT_CODE_EQ(scp_enc_progress(&b, &pr[i]), SCP_ERANGE, scp_err_name);
     uint8_t p[16];
     pt_put32(p, pr[i].job_id);
     pt_put32(p + 4, pr[i].stage);
@@ -829,20 +841,20 @@ static void test_ranges(void) {
     memcpy(&bits, &pr[i].fraction, 8);
     pt_put64(p + 8, bits);
     f = (scp_frame_t){.type = SCP_PROGRESS, .length = 16, .payload = p};
-    CHECK_RC(scp_parse(&f, &m), SCP_ERANGE);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ERANGE, scp_err_name);
   }
-  CHECK_U64_EQ(b.len, 0);
+  ASSERT_EQ(b.len, 0);
 
   /* ERROR: code 0, unknown flags, a NUL in the text, text too long. */
   scp_error_t e = {.code = 0};
-  CHECK_RC(scp_enc_error(&b, &e), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_enc_error(&b, &e), SCP_ERANGE, scp_err_name);
   e.code = 1;
   e.flags = 2;
-  CHECK_RC(scp_enc_error(&b, &e), SCP_EFLAGS);
+  ASSERT_CODE_EQ(scp_enc_error(&b, &e), SCP_EFLAGS, scp_err_name);
   e.flags = 0;
   memset(e.message, 'a', sizeof e.message); /* no terminating NUL */
-  CHECK_RC(scp_enc_error(&b, &e), SCP_ERANGE);
-  CHECK_U64_EQ(b.len, 0);
+  ASSERT_CODE_EQ(scp_enc_error(&b, &e), SCP_ERANGE, scp_err_name);
+  ASSERT_EQ(b.len, 0);
   e.message[0] = '\0';
   r = encoded(enc_error_, &e);
   pt_put32(r.p, 0);
@@ -859,9 +871,9 @@ static void test_ranges(void) {
 
   /* JOB_ERROR: job 0, code 0. */
   scp_job_error_t je = {.job_id = 0, .code = 1};
-  CHECK_RC(scp_enc_job_error(&b, &je), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_enc_job_error(&b, &je), SCP_ERANGE, scp_err_name);
   je = (scp_job_error_t){.job_id = 1, .code = 0};
-  CHECK_RC(scp_enc_job_error(&b, &je), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_enc_job_error(&b, &je), SCP_ERANGE, scp_err_name);
   je.code = 1;
   r = encoded(enc_job_error_, &je);
   pt_put32(r.p + 4, 0);
@@ -872,20 +884,27 @@ static void test_ranges(void) {
   double xyz[3] = {1, 2, 3};
   uint32_t tri[3] = {1, 2, 3};
   int32_t g[2] = {0, -2};
-  CHECK_RC(scp_enc_points(&b, 0, 0, SCP_F64_XYZ, xyz, 1), SCP_ERANGE);
-  CHECK_RC(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, xyz, 0), SCP_ERANGE);
-  CHECK_RC(scp_enc_points(&b, 1, 0, SCP_U32_TRIANGLE, xyz, 1), SCP_ERANGE);
-  CHECK_RC(scp_enc_points(&b, 1, 0, 77, xyz, 1), SCP_ERANGE);
-  CHECK_RC(scp_enc_points(&b, 1, UINT64_MAX, SCP_F64_XYZ, xyz, 1),
-           SCP_ERANGE);
-  CHECK_RC(scp_enc_triangles(&b, 1, UINT64_MAX - 1, tri, 1), 0);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 0, 0, SCP_F64_XYZ, xyz, 1), SCP_ERANGE,
+                 scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, xyz, 0), SCP_ERANGE,
+                 scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, 0, SCP_U32_TRIANGLE, xyz, 1), SCP_ERANGE,
+                 scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, 0, 77, xyz, 1), SCP_ERANGE,
+                 scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, UINT64_MAX, SCP_F64_XYZ, xyz, 1),
+                 SCP_ERANGE, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_triangles(&b, 1, UINT64_MAX - 1, tri, 1), 0,
+                 scp_err_name);
   scp_buf_consume(&b, b.len);
-  CHECK_RC(scp_enc_normals(&b, 1, 0, SCP_I32, xyz, 1), SCP_ERANGE);
-  CHECK_RC(scp_enc_components(&b, 1, 0, g, 2), SCP_ERANGE);
-  CHECK_RC(scp_enc_components(&b, 1, 0, g, 1), 0);
+  ASSERT_CODE_EQ(scp_enc_normals(&b, 1, 0, SCP_I32, xyz, 1), SCP_ERANGE,
+                 scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_components(&b, 1, 0, g, 2), SCP_ERANGE, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_components(&b, 1, 0, g, 1), 0, scp_err_name);
   scp_buf_consume(&b, b.len);
-  CHECK_RC(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, NULL, 1), SCP_EINVAL);
-  CHECK_U64_EQ(b.len, 0);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, NULL, 1), SCP_EINVAL,
+                 scp_err_name);
+  ASSERT_EQ(b.len, 0);
 
   struct {
     uint16_t type;
@@ -944,17 +963,17 @@ static void test_ranges(void) {
                              "a-b", "a b", "abc\xc3\xa9", too_long};
   for (size_t i = 0; i < sizeof bad_names / sizeof bad_names[0]; i++) {
     scp_value_t v = {.name = bad_names[i], .kind = SCP_KIND_U64};
-    CHECK_RC(scp_enc_stats(&b, 1, &v, 1), SCP_ERANGE);
+    ASSERT_CODE_EQ(scp_enc_stats(&b, 1, &v, 1), SCP_ERANGE, scp_err_name);
   }
   scp_value_t v = {.name = "ok", .kind = 0};
-  CHECK_RC(scp_enc_stats(&b, 1, &v, 1), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 1, &v, 1), SCP_ERANGE, scp_err_name);
   v.kind = 256;
-  CHECK_RC(scp_enc_stats(&b, 1, &v, 1), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 1, &v, 1), SCP_ERANGE, scp_err_name);
   v.name = NULL;
   v.kind = 1;
-  CHECK_RC(scp_enc_stats(&b, 1, &v, 1), SCP_EINVAL);
-  CHECK_RC(scp_enc_stats(&b, 1, NULL, 1), SCP_EINVAL);
-  CHECK_U64_EQ(b.len, 0);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 1, &v, 1), SCP_EINVAL, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 1, NULL, 1), SCP_EINVAL, scp_err_name);
+  ASSERT_EQ(b.len, 0);
 
   raw_t jd;
   memset(&jd, 0, sizeof jd);
@@ -978,7 +997,7 @@ static void test_ranges(void) {
 
   /* HELLO and WELCOME fields. */
   scp_hello_t h = {.version_min = 1, .version_max = 1, .max_frame = 4095};
-  CHECK_RC(scp_enc_hello(&b, &h), SCP_ERANGE);
+  ASSERT_CODE_EQ(scp_enc_hello(&b, &h), SCP_ERANGE, scp_err_name);
   scp_welcome_t w[] = {
       {.version = 1, .max_frame = 4095, .max_jobs = 1, .max_points = 1},
       {.version = 1, .max_frame = SCP_FRAME_CEILING + 1, .max_jobs = 1,
@@ -986,7 +1005,7 @@ static void test_ranges(void) {
       {.version = 1, .max_frame = 4096, .max_jobs = 0, .max_points = 1},
       {.version = 1, .max_frame = 4096, .max_jobs = 1, .max_points = 0}};
   for (size_t i = 0; i < sizeof w / sizeof w[0]; i++) {
-    CHECK_RC(scp_enc_welcome(&b, &w[i]), SCP_ERANGE);
+    ASSERT_CODE_EQ(scp_enc_welcome(&b, &w[i]), SCP_ERANGE, scp_err_name);
     uint8_t p[32] = {0};
     memcpy(p, SCP_MAGIC, 4);
     p[4] = 1;
@@ -994,25 +1013,25 @@ static void test_ranges(void) {
     pt_put32(p + 20, w[i].max_jobs);
     pt_put64(p + 24, w[i].max_points);
     f = (scp_frame_t){.type = SCP_WELCOME, .length = 32, .payload = p};
-    CHECK_RC(scp_parse(&f, &m), SCP_ERANGE);
+    ASSERT_CODE_EQ(scp_parse(&f, &m), SCP_ERANGE, scp_err_name);
   }
-  CHECK_U64_EQ(b.len, 0);
+  ASSERT_EQ(b.len, 0);
   scp_buf_free(&b);
 
   /* A parser handed the wrong type of frame. */
   f = (scp_frame_t){.type = SCP_PING, .length = 8, .payload = z};
   scp_job_end_t out;
-  CHECK_RC(scp_parse_job_end(&f, &out), SCP_EINVAL);
+  ASSERT_CODE_EQ(scp_parse_job_end(&f, &out), SCP_EINVAL, scp_err_name);
   scp_chunk_t chunk;
-  CHECK_RC(scp_parse_chunk(&f, &chunk), SCP_EINVAL);
+  ASSERT_CODE_EQ(scp_parse_chunk(&f, &chunk), SCP_EINVAL, scp_err_name);
 }
 
 static void test_feed_args(void) {
   scp_decoder_t *d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
-  CHECK_RC(scp_decoder_feed(d, NULL, 0), 0);
-  CHECK_RC(scp_decoder_feed(d, NULL, 1), SCP_EINVAL);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, NULL, 0), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, NULL, 1), SCP_EINVAL, scp_err_name);
   /* A caller's mistake does not poison the stream. */
-  CHECK_RC(scp_decoder_error(d), 0);
+  ASSERT_CODE_EQ(scp_decoder_error(d), 0, scp_err_name);
   scp_decoder_free(d);
   scp_decoder_free(NULL);
   scp_buf_free(NULL);
@@ -1029,6 +1048,5 @@ int main(void) {
   test_reserved();
   test_ranges();
   test_feed_args();
-  pt_done("proto_errors");
-  return 0;
+  return sct_finish("proto_errors");
 }

@@ -8,7 +8,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "ptest.h"
+#include "frames.h"
 
 static uint64_t buffer_of(const scp_decoder_t *d) {
   scp_decoder_counters_t c;
@@ -21,7 +21,7 @@ static scp_decoder_t *decoder(uint32_t max_frame) {
   scp_limits_init(&lim);
   lim.max_frame = max_frame;
   scp_decoder_t *d = scp_decoder_new(&lim);
-  CHECK(d != NULL);
+  ASSERT_NOT_NULL(d);
   return d;
 }
 
@@ -32,10 +32,10 @@ static void test_claimed_length(void) {
   pt_header(h, SCP_POINTS, 0, SCP_FRAME_CEILING - SCP_HEADER_SIZE);
   memset(h + SCP_HEADER_SIZE, 0, 24);
   scp_frame_t f;
-  CHECK_RC(scp_decoder_feed(d, h, sizeof h), 0);
-  CHECK_RC(scp_decoder_next(d, &f), 0);
-  CHECK(buffer_of(d) <= SCP_FRAME_MIN);
-  CHECK_U64_EQ(scp_decoder_pending(d), sizeof h);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, h, sizeof h), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 0, scp_err_name);
+  ASSERT_LE(buffer_of(d), SCP_FRAME_MIN);
+  ASSERT_EQ(scp_decoder_pending(d), sizeof h);
   scp_decoder_free(d);
 }
 
@@ -48,10 +48,10 @@ static void test_ignorable_not_buffered(void) {
   scp_frame_t f;
   while (sent < total) {
     size_t n = total - sent < sizeof piece ? total - sent : sizeof piece;
-    CHECK_RC(scp_decoder_feed(d, piece, n), 0);
-    CHECK_RC(scp_decoder_next(d, &f), 0);
-    CHECK_U64_EQ(scp_decoder_pending(d), 0);
-    CHECK(buffer_of(d) <= SCP_FRAME_MIN);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, piece, n), 0, scp_err_name);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), 0, scp_err_name);
+    ASSERT_EQ(scp_decoder_pending(d), 0);
+    ASSERT_LE(buffer_of(d), SCP_FRAME_MIN);
     sent += n;
     memset(piece, 0x22, SCP_HEADER_SIZE); /* later pieces are payload */
   }
@@ -59,10 +59,10 @@ static void test_ignorable_not_buffered(void) {
   uint8_t ping[16];
   pt_header(ping, SCP_PING, 0, 8);
   memset(ping + 8, 0, 8);
-  CHECK_RC(scp_decoder_feed(d, ping, sizeof ping), 0);
-  CHECK_RC(scp_decoder_next(d, &f), 1);
-  CHECK_INT_EQ(f.type, SCP_PING);
-  CHECK_RC(scp_decoder_eof(d), 0);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, ping, sizeof ping), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, SCP_PING);
+  ASSERT_CODE_EQ(scp_decoder_eof(d), 0, scp_err_name);
   scp_decoder_free(d);
 }
 
@@ -70,11 +70,12 @@ static void test_large_frame_then_idle(void) {
   const uint32_t limit = 2u << 20;
   const uint32_t npoints = 43689; /* about 1 MiB as F64_XYZ */
   double *xyz = calloc(3 * (size_t)npoints, sizeof *xyz);
-  CHECK(xyz != NULL);
+  ASSERT_NOT_NULL(xyz);
   scp_buf_t b;
   scp_buf_init(&b, limit);
-  CHECK_RC(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, xyz, npoints), 0);
-  CHECK_RC(scp_enc_ping(&b, 5), 0);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, xyz, npoints), 0,
+                 scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_ping(&b, 5), 0, scp_err_name);
   free(xyz);
 
   scp_decoder_t *d = decoder(limit);
@@ -85,27 +86,27 @@ static void test_large_frame_then_idle(void) {
   scp_frame_t f;
   for (size_t at = 0; at < b.len; at += piece) {
     size_t n = b.len - at < piece ? b.len - at : piece;
-    CHECK_RC(scp_decoder_feed(d, b.data + at, n), 0);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, b.data + at, n), 0, scp_err_name);
     /* One partial frame plus one feed, with room to double. */
-    CHECK(scp_decoder_pending(d) <= frame + piece);
+    ASSERT_LE(scp_decoder_pending(d), frame + piece);
     uint64_t now = buffer_of(d);
     if (now > peak)
       peak = now;
     int rc;
     while ((rc = scp_decoder_next(d, &f)) == 1)
       frames++;
-    CHECK_RC(rc, 0);
+    ASSERT_CODE_EQ(rc, 0, scp_err_name);
   }
-  CHECK_INT_EQ(frames, 2);
-  CHECK(peak >= frame);
-  CHECK(peak <= 2 * (frame + piece));
-  CHECK_RC(scp_decoder_eof(d), 0);
+  ASSERT_EQ(frames, 2);
+  ASSERT_GE(peak, frame);
+  ASSERT_LE(peak, 2 * (frame + piece));
+  ASSERT_CODE_EQ(scp_decoder_eof(d), 0, scp_err_name);
 
   /* Idle now: the next small feed finds the big buffer given back. */
-  CHECK_RC(scp_decoder_feed(d, b.data + b.len - 16, 16), 0);
-  CHECK(buffer_of(d) <= 64 * 1024);
-  CHECK_RC(scp_decoder_next(d, &f), 1);
-  CHECK_INT_EQ(f.type, SCP_PING);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data + b.len - 16, 16), 0, scp_err_name);
+  ASSERT_LE(buffer_of(d), 64 * 1024);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, SCP_PING);
   scp_decoder_free(d);
   scp_buf_free(&b);
 }
@@ -114,6 +115,5 @@ int main(void) {
   test_claimed_length();
   test_ignorable_not_buffered();
   test_large_frame_then_idle();
-  pt_done("proto_memory");
-  return 0;
+  return sct_finish("proto_memory");
 }

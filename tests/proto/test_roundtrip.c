@@ -8,7 +8,7 @@
  */
 #include <math.h>
 
-#include "ptest.h"
+#include "frames.h"
 
 /* Decodes the single frame in b, parses it, checks that re-encoding the
  * parsed message gives the same bytes, and hands back the message. The
@@ -17,15 +17,15 @@ static scp_decoder_t *reparse(const scp_buf_t *b, uint16_t type,
                               scp_msg_t *msg) {
   scp_frame_t f;
   scp_decoder_t *d = pt_decode_one(b->data, b->len, &f);
-  CHECK_INT_EQ(f.type, type);
-  CHECK_U64_EQ(f.length + SCP_HEADER_SIZE, b->len);
-  CHECK_RC(scp_parse(&f, msg), 0);
-  CHECK_INT_EQ(msg->type, type);
+  ASSERT_EQ(f.type, type);
+  ASSERT_EQ(f.length + SCP_HEADER_SIZE, b->len);
+  ASSERT_CODE_EQ(scp_parse(&f, msg), 0, scp_err_name);
+  ASSERT_EQ(msg->type, type);
 
   scp_buf_t again;
   scp_buf_init(&again, SCP_FRAME_CEILING);
-  CHECK_RC(scp_enc_msg(&again, msg), 0);
-  CHECK_MEM_EQ(again.data, again.len, b->data, b->len);
+  ASSERT_CODE_EQ(scp_enc_msg(&again, msg), 0, scp_err_name);
+  ASSERT_MEM_EQ(again.data, again.len, b->data, b->len);
   scp_buf_free(&again);
   return d;
 }
@@ -39,13 +39,13 @@ static void test_handshake(void) {
                    .version_max = 7,
                    .features = 0x8000000000000001u,
                    .max_frame = 0xFFFFFFFFu};
-  CHECK_RC(scp_enc_hello(&b, &h), 0);
-  CHECK_U64_EQ(b.len, 8 + 24);
+  ASSERT_CODE_EQ(scp_enc_hello(&b, &h), 0, scp_err_name);
+  ASSERT_EQ(b.len, 8 + 24);
   scp_decoder_t *d = reparse(&b, SCP_HELLO, &m);
-  CHECK_INT_EQ(m.u.hello.version_min, 1);
-  CHECK_INT_EQ(m.u.hello.version_max, 7);
-  CHECK_U64_EQ(m.u.hello.features, 0x8000000000000001u);
-  CHECK_U64_EQ(m.u.hello.max_frame, 0xFFFFFFFFu);
+  ASSERT_EQ(m.u.hello.version_min, 1);
+  ASSERT_EQ(m.u.hello.version_max, 7);
+  ASSERT_EQ(m.u.hello.features, 0x8000000000000001u);
+  ASSERT_EQ(m.u.hello.max_frame, 0xFFFFFFFFu);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
@@ -54,14 +54,14 @@ static void test_handshake(void) {
                      .max_frame = SCP_FRAME_CEILING,
                      .max_jobs = 0xFFFFFFFFu,
                      .max_points = UINT64_MAX};
-  CHECK_RC(scp_enc_welcome(&b, &w), 0);
-  CHECK_U64_EQ(b.len, 8 + 32);
+  ASSERT_CODE_EQ(scp_enc_welcome(&b, &w), 0, scp_err_name);
+  ASSERT_EQ(b.len, 8 + 32);
   d = reparse(&b, SCP_WELCOME, &m);
-  CHECK_INT_EQ(m.u.welcome.version, 1);
-  CHECK_U64_EQ(m.u.welcome.features, 0);
-  CHECK_U64_EQ(m.u.welcome.max_frame, SCP_FRAME_CEILING);
-  CHECK_U64_EQ(m.u.welcome.max_jobs, 0xFFFFFFFFu);
-  CHECK_U64_EQ(m.u.welcome.max_points, UINT64_MAX);
+  ASSERT_EQ(m.u.welcome.version, 1);
+  ASSERT_EQ(m.u.welcome.features, 0);
+  ASSERT_EQ(m.u.welcome.max_frame, SCP_FRAME_CEILING);
+  ASSERT_EQ(m.u.welcome.max_jobs, 0xFFFFFFFFu);
+  ASSERT_EQ(m.u.welcome.max_points, UINT64_MAX);
   scp_decoder_free(d);
   scp_buf_free(&b);
 
@@ -72,19 +72,19 @@ static void test_handshake(void) {
                           .max_jobs = 8,
                           .max_points = 10000000};
   scp_welcome_t ans;
-  CHECK_RC(scp_handshake_answer(&h, &server, &ans), 0);
-  CHECK_INT_EQ(ans.version, SCP_VERSION);
-  CHECK_U64_EQ(ans.features, 0x1);
-  CHECK_U64_EQ(ans.max_frame, 1u << 20);
-  CHECK_U64_EQ(ans.max_jobs, 8);
-  CHECK_U64_EQ(ans.max_points, 10000000);
-  CHECK_RC(scp_handshake_check(&h, &ans), 0);
+  ASSERT_CODE_EQ(scp_handshake_answer(&h, &server, &ans), 0, scp_err_name);
+  ASSERT_EQ(ans.version, SCP_VERSION);
+  ASSERT_EQ(ans.features, 0x1);
+  ASSERT_EQ(ans.max_frame, 1u << 20);
+  ASSERT_EQ(ans.max_jobs, 8);
+  ASSERT_EQ(ans.max_points, 10000000);
+  ASSERT_CODE_EQ(scp_handshake_check(&h, &ans), 0, scp_err_name);
   scp_hello_t small = {.version_min = 1, .version_max = 1,
                        .max_frame = SCP_FRAME_MIN};
-  CHECK_RC(scp_handshake_answer(&small, &server, &ans), 0);
-  CHECK_U64_EQ(ans.max_frame, SCP_FRAME_MIN);
-  CHECK_U64_EQ(ans.features, 0);
-  CHECK_RC(scp_handshake_check(&small, &ans), 0);
+  ASSERT_CODE_EQ(scp_handshake_answer(&small, &server, &ans), 0, scp_err_name);
+  ASSERT_EQ(ans.max_frame, SCP_FRAME_MIN);
+  ASSERT_EQ(ans.features, 0);
+  ASSERT_CODE_EQ(scp_handshake_check(&small, &ans), 0, scp_err_name);
 }
 
 static void test_error_ping(void) {
@@ -97,13 +97,13 @@ static void test_error_ping(void) {
                    .job_id = 0,
                    .ref_type = 0x0099};
   strcpy(e.message, "frame type 0x0099 is not known");
-  CHECK_RC(scp_enc_error(&b, &e), 0);
+  ASSERT_CODE_EQ(scp_enc_error(&b, &e), 0, scp_err_name);
   scp_decoder_t *d = reparse(&b, SCP_ERROR, &m);
-  CHECK_U64_EQ(m.u.error.code, SCP_WIRE_UNKNOWN_TYPE);
-  CHECK_U64_EQ(m.u.error.flags, 0);
-  CHECK_U64_EQ(m.u.error.job_id, 0);
-  CHECK_INT_EQ(m.u.error.ref_type, 0x0099);
-  CHECK_STR_EQ(m.u.error.message, "frame type 0x0099 is not known");
+  ASSERT_EQ(m.u.error.code, SCP_WIRE_UNKNOWN_TYPE);
+  ASSERT_EQ(m.u.error.flags, 0);
+  ASSERT_EQ(m.u.error.job_id, 0);
+  ASSERT_EQ(m.u.error.ref_type, 0x0099);
+  ASSERT_STR_EQ(m.u.error.message, "frame type 0x0099 is not known");
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
@@ -114,39 +114,39 @@ static void test_error_ping(void) {
   e.ref_type = SCP_POINTS;
   memset(e.message, 'x', SCP_MESSAGE_MAX);
   e.message[SCP_MESSAGE_MAX] = '\0';
-  CHECK_RC(scp_enc_error(&b, &e), 0);
-  CHECK_U64_EQ(b.len, 8 + 20 + SCP_MESSAGE_MAX);
+  ASSERT_CODE_EQ(scp_enc_error(&b, &e), 0, scp_err_name);
+  ASSERT_EQ(b.len, 8 + 20 + SCP_MESSAGE_MAX);
   d = reparse(&b, SCP_ERROR, &m);
-  CHECK_U64_EQ(m.u.error.code, 1000);
-  CHECK_U64_EQ(m.u.error.flags, SCP_ERROR_FATAL);
-  CHECK_U64_EQ(m.u.error.job_id, 42);
-  CHECK_U64_EQ(strlen(m.u.error.message), SCP_MESSAGE_MAX);
+  ASSERT_EQ(m.u.error.code, 1000);
+  ASSERT_EQ(m.u.error.flags, SCP_ERROR_FATAL);
+  ASSERT_EQ(m.u.error.job_id, 42);
+  ASSERT_EQ(strlen(m.u.error.message), SCP_MESSAGE_MAX);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   /* An empty message. */
   e.message[0] = '\0';
-  CHECK_RC(scp_enc_error(&b, &e), 0);
+  ASSERT_CODE_EQ(scp_enc_error(&b, &e), 0, scp_err_name);
   d = reparse(&b, SCP_ERROR, &m);
-  CHECK_STR_EQ(m.u.error.message, "");
+  ASSERT_STR_EQ(m.u.error.message, "");
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
-  CHECK_RC(scp_enc_ping(&b, 0x0123456789abcdefu), 0);
+  ASSERT_CODE_EQ(scp_enc_ping(&b, 0x0123456789abcdefu), 0, scp_err_name);
   d = reparse(&b, SCP_PING, &m);
-  CHECK_U64_EQ(m.u.token, 0x0123456789abcdefu);
+  ASSERT_EQ(m.u.token, 0x0123456789abcdefu);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
-  CHECK_RC(scp_enc_pong(&b, UINT64_MAX), 0);
+  ASSERT_CODE_EQ(scp_enc_pong(&b, UINT64_MAX), 0, scp_err_name);
   d = reparse(&b, SCP_PONG, &m);
-  CHECK_U64_EQ(m.u.token, UINT64_MAX);
+  ASSERT_EQ(m.u.token, UINT64_MAX);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
-  CHECK_RC(scp_enc_stats_request(&b, 77), 0);
+  ASSERT_CODE_EQ(scp_enc_stats_request(&b, 77), 0, scp_err_name);
   d = reparse(&b, SCP_STATS_REQUEST, &m);
-  CHECK_U64_EQ(m.u.tag, 77);
+  ASSERT_EQ(m.u.tag, 77);
   scp_decoder_free(d);
   scp_buf_free(&b);
 }
@@ -162,25 +162,25 @@ static void test_job_frames(void) {
                         .theta = 1.5707963267948963,
                         .point_count = 123456789012345u,
                         .flags = SCP_JOB_NORMALS | SCP_JOB_NORMALS_F64};
-  CHECK_RC(scp_enc_job_begin(&b, &jb), 0);
+  ASSERT_CODE_EQ(scp_enc_job_begin(&b, &jb), 0, scp_err_name);
   scp_decoder_t *d = reparse(&b, SCP_JOB_BEGIN, &m);
-  CHECK_U64_EQ(m.u.job_begin.job_id, 0xFFFFFFFFu);
-  CHECK_U64_EQ(m.u.job_begin.mode, SCP_MODE_AUTO);
-  CHECK_DBL_SAME(m.u.job_begin.r, 0.4999999999999999);
-  CHECK_DBL_SAME(m.u.job_begin.theta, 1.5707963267948963);
-  CHECK_U64_EQ(m.u.job_begin.point_count, 123456789012345u);
-  CHECK_U64_EQ(m.u.job_begin.flags, SCP_JOB_NORMALS | SCP_JOB_NORMALS_F64);
+  ASSERT_EQ(m.u.job_begin.job_id, 0xFFFFFFFFu);
+  ASSERT_EQ(m.u.job_begin.mode, SCP_MODE_AUTO);
+  ASSERT_DBL_SAME(m.u.job_begin.r, 0.4999999999999999);
+  ASSERT_DBL_SAME(m.u.job_begin.theta, 1.5707963267948963);
+  ASSERT_EQ(m.u.job_begin.point_count, 123456789012345u);
+  ASSERT_EQ(m.u.job_begin.flags, SCP_JOB_NORMALS | SCP_JOB_NORMALS_F64);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   /* The smallest r, the default theta, no normals, unknown count. */
   jb = (scp_job_begin_t){.job_id = 1, .mode = 0, .r = 4.9e-324};
-  CHECK_RC(scp_enc_job_begin(&b, &jb), 0);
+  ASSERT_CODE_EQ(scp_enc_job_begin(&b, &jb), 0, scp_err_name);
   d = reparse(&b, SCP_JOB_BEGIN, &m);
-  CHECK_DBL_SAME(m.u.job_begin.r, 4.9e-324);
-  CHECK_DBL_SAME(m.u.job_begin.theta, 0.0);
-  CHECK_U64_EQ(m.u.job_begin.point_count, 0);
-  CHECK_U64_EQ(m.u.job_begin.flags, 0);
+  ASSERT_DBL_SAME(m.u.job_begin.r, 4.9e-324);
+  ASSERT_DBL_SAME(m.u.job_begin.theta, 0.0);
+  ASSERT_EQ(m.u.job_begin.point_count, 0);
+  ASSERT_EQ(m.u.job_begin.flags, 0);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
@@ -191,72 +191,73 @@ static void test_job_frames(void) {
       {.name = SCP_OPT_BOUNDARY_RHO, .kind = SCP_KIND_F64, .v.f = 1.25},
       {.name = "later.option", .kind = 200, .v.u = 0x0102030405060708u}};
   jb = (scp_job_begin_t){.job_id = 3, .mode = SCP_MODE_BOUNDARY, .r = 0.18};
-  CHECK_RC(scp_enc_job_begin_options(&b, &jb, opts, 3), 0);
-  CHECK_U64_EQ(b.len, SCP_HEADER_SIZE + 48 + (10 + 14) + (10 + 12) + (10 + 12));
+  ASSERT_CODE_EQ(scp_enc_job_begin_options(&b, &jb, opts, 3), 0, scp_err_name);
+  ASSERT_EQ(b.len, SCP_HEADER_SIZE + 48 + (10 + 14) + (10 + 12) + (10 + 12));
   d = reparse(&b, SCP_JOB_BEGIN, &m);
-  CHECK_U64_EQ(m.u.job_begin.job_id, 3);
-  CHECK_U64_EQ(m.u.job_begin.options.count, 3);
+  ASSERT_EQ(m.u.job_begin.job_id, 3);
+  ASSERT_EQ(m.u.job_begin.options.count, 3);
   {
     scp_value_iter_t it;
     scp_value_t v;
     scp_values_begin(&m.u.job_begin.options, &it);
     for (int i = 0; i < 3; i++) {
-      CHECK_INT_EQ(scp_values_next(&it, &v), 1);
-      CHECK_INT_EQ(strcmp(v.name, opts[i].name), 0);
-      CHECK_U64_EQ(v.kind, opts[i].kind);
-      CHECK_U64_EQ(v.v.u, opts[i].v.u);
+      ASSERT_EQ(scp_values_next(&it, &v), 1);
+      ASSERT_EQ(strcmp(v.name, opts[i].name), 0);
+      ASSERT_EQ(v.kind, opts[i].kind);
+      ASSERT_EQ(v.v.u, opts[i].v.u);
     }
-    CHECK_INT_EQ(scp_values_next(&it, &v), 0);
+    ASSERT_EQ(scp_values_next(&it, &v), 0);
   }
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
   /* No options: the 40-byte form, whatever the array pointer. */
-  CHECK_RC(scp_enc_job_begin_options(&b, &jb, opts, 0), 0);
-  CHECK_U64_EQ(b.len, SCP_HEADER_SIZE + 40);
+  ASSERT_CODE_EQ(scp_enc_job_begin_options(&b, &jb, opts, 0), 0, scp_err_name);
+  ASSERT_EQ(b.len, SCP_HEADER_SIZE + 40);
   d = reparse(&b, SCP_JOB_BEGIN, &m);
-  CHECK_U64_EQ(m.u.job_begin.options.count, 0);
+  ASSERT_EQ(m.u.job_begin.options.count, 0);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   scp_job_end_t je = {.job_id = 9, .point_count = UINT64_MAX};
-  CHECK_RC(scp_enc_job_end(&b, &je), 0);
+  ASSERT_CODE_EQ(scp_enc_job_end(&b, &je), 0, scp_err_name);
   d = reparse(&b, SCP_JOB_END, &m);
-  CHECK_U64_EQ(m.u.job_end.job_id, 9);
-  CHECK_U64_EQ(m.u.job_end.point_count, UINT64_MAX);
+  ASSERT_EQ(m.u.job_end.job_id, 9);
+  ASSERT_EQ(m.u.job_end.point_count, UINT64_MAX);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
-  CHECK_RC(scp_enc_cancel(&b, 12), 0);
+  ASSERT_CODE_EQ(scp_enc_cancel(&b, 12), 0, scp_err_name);
   d = reparse(&b, SCP_CANCEL, &m);
-  CHECK_U64_EQ(m.u.job_id, 12);
+  ASSERT_EQ(m.u.job_id, 12);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   scp_accepted_t acc = {.job_id = 3, .queue_position = 0xFFFFFFFFu};
-  CHECK_RC(scp_enc_accepted(&b, &acc), 0);
+  ASSERT_CODE_EQ(scp_enc_accepted(&b, &acc), 0, scp_err_name);
   d = reparse(&b, SCP_ACCEPTED, &m);
-  CHECK_U64_EQ(m.u.accepted.job_id, 3);
-  CHECK_U64_EQ(m.u.accepted.queue_position, 0xFFFFFFFFu);
+  ASSERT_EQ(m.u.accepted.job_id, 3);
+  ASSERT_EQ(m.u.accepted.queue_position, 0xFFFFFFFFu);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   for (uint32_t stage = 0; stage < SCP_STAGE_COUNT; stage++) {
     scp_progress_t pr = {.job_id = 3, .stage = stage, .fraction = stage / 5.0};
-    CHECK_RC(scp_enc_progress(&b, &pr), 0);
+    ASSERT_CODE_EQ(scp_enc_progress(&b, &pr), 0, scp_err_name);
     d = reparse(&b, SCP_PROGRESS, &m);
-    CHECK_U64_EQ(m.u.progress.stage, stage);
-    CHECK_DBL_SAME(m.u.progress.fraction, stage / 5.0);
+    ASSERT_EQ(m.u.progress.stage, stage);
+    ASSERT_DBL_SAME(m.u.progress.fraction, stage / 5.0);
     scp_decoder_free(d);
     scp_buf_consume(&b, b.len);
   }
 
   scp_job_error_t jerr = {.job_id = 3, .code = SCP_WIRE_DEGENERATE_INPUT};
   strcpy(jerr.message, "all 12 points lie in one plane \xc3\xa9");
-  CHECK_RC(scp_enc_job_error(&b, &jerr), 0);
+  ASSERT_CODE_EQ(scp_enc_job_error(&b, &jerr), 0, scp_err_name);
   d = reparse(&b, SCP_JOB_ERROR, &m);
-  CHECK_U64_EQ(m.u.job_error.job_id, 3);
-  CHECK_U64_EQ(m.u.job_error.code, SCP_WIRE_DEGENERATE_INPUT);
-  CHECK_STR_EQ(m.u.job_error.message, "all 12 points lie in one plane \xc3\xa9");
+  ASSERT_EQ(m.u.job_error.job_id, 3);
+  ASSERT_EQ(m.u.job_error.code, SCP_WIRE_DEGENERATE_INPUT);
+  ASSERT_STR_EQ(m.u.job_error.message,
+                "all 12 points lie in one plane \xc3\xa9");
   scp_decoder_free(d);
   scp_buf_free(&b);
 }
@@ -283,32 +284,32 @@ static void test_values(void) {
                        .triangles = 199996,
                        .normals = 100000,
                        .components = UINT64_MAX};
-  CHECK_RC(scp_enc_job_done(&b, &jd, vals, n), 0);
+  ASSERT_CODE_EQ(scp_enc_job_done(&b, &jd, vals, n), 0, scp_err_name);
   scp_decoder_t *d = reparse(&b, SCP_JOB_DONE, &m);
-  CHECK_U64_EQ(m.u.job_done.job_id, 5);
-  CHECK_U64_EQ(m.u.job_done.triangles, 199996);
-  CHECK_U64_EQ(m.u.job_done.normals, 100000);
-  CHECK_U64_EQ(m.u.job_done.components, UINT64_MAX);
-  CHECK_U64_EQ(m.u.job_done.values.count, n);
+  ASSERT_EQ(m.u.job_done.job_id, 5);
+  ASSERT_EQ(m.u.job_done.triangles, 199996);
+  ASSERT_EQ(m.u.job_done.normals, 100000);
+  ASSERT_EQ(m.u.job_done.components, UINT64_MAX);
+  ASSERT_EQ(m.u.job_done.values.count, n);
 
   scp_value_iter_t it;
   scp_value_t v;
   uint32_t i = 0;
   scp_values_begin(&m.u.job_done.values, &it);
   while (scp_values_next(&it, &v)) {
-    CHECK(i < n);
-    CHECK_STR_EQ(v.name, vals[i].name);
-    CHECK_U64_EQ(v.kind, vals[i].kind);
+    ASSERT_LT(i, n);
+    ASSERT_STR_EQ(v.name, vals[i].name);
+    ASSERT_EQ(v.kind, vals[i].kind);
     /* Every kind, known or not, keeps its eight bytes. */
-    CHECK_U64_EQ(v.v.u, vals[i].v.u);
+    ASSERT_EQ(v.v.u, vals[i].v.u);
     i++;
   }
-  CHECK_U64_EQ(i, n);
-  CHECK(scp_values_find(&m.u.job_done.values, "euler", &it, &v));
-  CHECK_INT_EQ(v.v.i, INT64_MIN);
-  CHECK(scp_values_find(&m.u.job_done.values, longname, &it, &v));
-  CHECK(isnan(v.v.f));
-  CHECK(!scp_values_find(&m.u.job_done.values, "genus", &it, &v));
+  ASSERT_EQ(i, n);
+  ASSERT(scp_values_find(&m.u.job_done.values, "euler", &it, &v));
+  ASSERT_EQ(v.v.i, INT64_MIN);
+  ASSERT(scp_values_find(&m.u.job_done.values, longname, &it, &v));
+  ASSERT(isnan(v.v.f));
+  ASSERT(!scp_values_find(&m.u.job_done.values, "genus", &it, &v));
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
@@ -316,25 +317,25 @@ static void test_values(void) {
    * one (PROTOCOL.md 6.11). */
   scp_value_t twice[] = {{.name = "jobs_total", .kind = SCP_KIND_U64, .v.u = 1},
                          {.name = "jobs_total", .kind = SCP_KIND_U64, .v.u = 2}};
-  CHECK_RC(scp_enc_stats(&b, 0xabcdef, twice, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 0xabcdef, twice, 2), 0, scp_err_name);
   d = reparse(&b, SCP_STATS, &m);
-  CHECK_U64_EQ(m.u.stats.tag, 0xabcdef);
-  CHECK(scp_values_find(&m.u.stats.values, "jobs_total", &it, &v));
-  CHECK_U64_EQ(v.v.u, 1);
+  ASSERT_EQ(m.u.stats.tag, 0xabcdef);
+  ASSERT(scp_values_find(&m.u.stats.values, "jobs_total", &it, &v));
+  ASSERT_EQ(v.v.u, 1);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   /* Empty lists. */
-  CHECK_RC(scp_enc_stats(&b, 0, NULL, 0), 0);
-  CHECK_U64_EQ(b.len, 8 + 8);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 0, NULL, 0), 0, scp_err_name);
+  ASSERT_EQ(b.len, 8 + 8);
   d = reparse(&b, SCP_STATS, &m);
-  CHECK_U64_EQ(m.u.stats.values.count, 0);
+  ASSERT_EQ(m.u.stats.values.count, 0);
   scp_values_begin(&m.u.stats.values, &it);
-  CHECK(!scp_values_next(&it, &v));
+  ASSERT(!scp_values_next(&it, &v));
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
-  CHECK_RC(scp_enc_job_done(&b, &jd, NULL, 0), 0);
-  CHECK_U64_EQ(b.len, 8 + 32);
+  ASSERT_CODE_EQ(scp_enc_job_done(&b, &jd, NULL, 0), 0, scp_err_name);
+  ASSERT_EQ(b.len, 8 + 32);
   d = reparse(&b, SCP_JOB_DONE, &m);
   scp_decoder_free(d);
   scp_buf_free(&b);
@@ -352,35 +353,38 @@ static void test_chunks(void) {
   xyz[5] = -0.0;
 
   /* POINTS as f64 keep every bit. */
-  CHECK_RC(scp_enc_points(&b, 7, 100, SCP_F64_XYZ, xyz, 5), 0);
-  CHECK_U64_EQ(b.len, 8 + 24 + 5 * 24);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 7, 100, SCP_F64_XYZ, xyz, 5), 0,
+                 scp_err_name);
+  ASSERT_EQ(b.len, 8 + 24 + 5 * 24);
   d = reparse(&b, SCP_POINTS, &m);
-  CHECK_INT_EQ(m.u.chunk.type, SCP_POINTS);
-  CHECK_U64_EQ(m.u.chunk.job_id, 7);
-  CHECK_U64_EQ(m.u.chunk.count, 5);
-  CHECK_U64_EQ(m.u.chunk.first, 100);
-  CHECK_U64_EQ(m.u.chunk.format, SCP_F64_XYZ);
+  ASSERT_EQ(m.u.chunk.type, SCP_POINTS);
+  ASSERT_EQ(m.u.chunk.job_id, 7);
+  ASSERT_EQ(m.u.chunk.count, 5);
+  ASSERT_EQ(m.u.chunk.first, 100);
+  ASSERT_EQ(m.u.chunk.format, SCP_F64_XYZ);
   double back[15];
-  CHECK_RC(scp_chunk_copy_xyz(&m.u.chunk, back), 0);
+  ASSERT_CODE_EQ(scp_chunk_copy_xyz(&m.u.chunk, back), 0, scp_err_name);
   for (int i = 0; i < 15; i++)
-    CHECK_DBL_SAME(back[i], xyz[i]);
+    ASSERT_DBL_SAME(back[i], xyz[i]);
   double one[3];
   scp_chunk_xyz(&m.u.chunk, 4, one);
-  CHECK_DBL_SAME(one[2], xyz[14]);
+  ASSERT_DBL_SAME(one[2], xyz[14]);
   uint32_t tri[3];
-  CHECK_RC(scp_chunk_copy_triangles(&m.u.chunk, tri), SCP_EINVAL);
+  ASSERT_CODE_EQ(scp_chunk_copy_triangles(&m.u.chunk, tri), SCP_EINVAL,
+                 scp_err_name);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   /* POINTS as f32 round to float, beyond-range values to infinity. */
   double big[3] = {1e300, -1e300, 0.1};
-  CHECK_RC(scp_enc_points(&b, 7, 0, SCP_F32_XYZ, big, 1), 0);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 7, 0, SCP_F32_XYZ, big, 1), 0,
+                 scp_err_name);
   d = reparse(&b, SCP_POINTS, &m);
   float f[3];
   scp_chunk_xyz_f32(&m.u.chunk, 0, f);
-  CHECK(isinf(f[0]) && f[0] > 0);
-  CHECK(isinf(f[1]) && f[1] < 0);
-  CHECK_DBL_SAME(f[2], (double)0.1f);
+  ASSERT(isinf(f[0]) && f[0] > 0);
+  ASSERT(isinf(f[1]) && f[1] < 0);
+  ASSERT_DBL_SAME(f[2], (double)0.1f);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
@@ -388,57 +392,61 @@ static void test_chunks(void) {
   float fin[6] = {1.5f, -2.25f, 3.0f, 0.0f, 0.0f, 0.0f};
   uint32_t nan_bits = 0x7fc01234u;
   memcpy(&fin[3], &nan_bits, sizeof nan_bits);
-  CHECK_RC(scp_enc_points_f32(&b, 2, 5, fin, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_points_f32(&b, 2, 5, fin, 2), 0, scp_err_name);
   d = reparse(&b, SCP_POINTS, &m);
-  CHECK_U64_EQ(m.u.chunk.format, SCP_F32_XYZ);
+  ASSERT_EQ(m.u.chunk.format, SCP_F32_XYZ);
   scp_chunk_xyz_f32(&m.u.chunk, 1, f);
   uint32_t got_bits;
   memcpy(&got_bits, &f[0], sizeof got_bits);
-  CHECK_U64_EQ(got_bits, nan_bits);
+  ASSERT_EQ(got_bits, nan_bits);
   scp_chunk_xyz(&m.u.chunk, 0, one);
-  CHECK_DBL_SAME(one[0], 1.5);
-  CHECK_DBL_SAME(one[1], -2.25);
+  ASSERT_DBL_SAME(one[0], 1.5);
+  ASSERT_DBL_SAME(one[1], -2.25);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   uint32_t tris[6] = {0, 2, 1, 0xFFFFFFFFu, 1, 3};
-  CHECK_RC(scp_enc_triangles(&b, 7, UINT64_MAX - 2, tris, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_triangles(&b, 7, UINT64_MAX - 2, tris, 2), 0,
+                 scp_err_name);
   d = reparse(&b, SCP_TRIANGLES, &m);
-  CHECK_U64_EQ(m.u.chunk.first, UINT64_MAX - 2);
+  ASSERT_EQ(m.u.chunk.first, UINT64_MAX - 2);
   uint32_t tback[6];
-  CHECK_RC(scp_chunk_copy_triangles(&m.u.chunk, tback), 0);
+  ASSERT_CODE_EQ(scp_chunk_copy_triangles(&m.u.chunk, tback), 0, scp_err_name);
   for (int i = 0; i < 6; i++)
-    CHECK_U64_EQ(tback[i], tris[i]);
+    ASSERT_EQ(tback[i], tris[i]);
   scp_chunk_triangle(&m.u.chunk, 1, tri);
-  CHECK_U64_EQ(tri[0], 0xFFFFFFFFu);
-  CHECK_U64_EQ(tri[2], 3);
-  CHECK_RC(scp_chunk_copy_xyz(&m.u.chunk, back), SCP_EINVAL);
+  ASSERT_EQ(tri[0], 0xFFFFFFFFu);
+  ASSERT_EQ(tri[2], 3);
+  ASSERT_CODE_EQ(scp_chunk_copy_xyz(&m.u.chunk, back), SCP_EINVAL,
+                 scp_err_name);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   double normals[6] = {0, 0, 1, 0.6, 0.8, 0};
-  CHECK_RC(scp_enc_normals(&b, 7, 0, SCP_F32_XYZ, normals, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_normals(&b, 7, 0, SCP_F32_XYZ, normals, 2), 0,
+                 scp_err_name);
   d = reparse(&b, SCP_NORMALS, &m);
-  CHECK_U64_EQ(m.u.chunk.format, SCP_F32_XYZ);
+  ASSERT_EQ(m.u.chunk.format, SCP_F32_XYZ);
   scp_chunk_xyz(&m.u.chunk, 1, one);
-  CHECK_DBL_SAME(one[0], (double)0.6f);
+  ASSERT_DBL_SAME(one[0], (double)0.6f);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
-  CHECK_RC(scp_enc_normals(&b, 7, 2, SCP_F64_XYZ, normals, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_normals(&b, 7, 2, SCP_F64_XYZ, normals, 2), 0,
+                 scp_err_name);
   d = reparse(&b, SCP_NORMALS, &m);
   scp_chunk_xyz(&m.u.chunk, 1, one);
-  CHECK_DBL_SAME(one[0], 0.6);
+  ASSERT_DBL_SAME(one[0], 0.6);
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
   int32_t genus[4] = {-1, 0, 7, INT32_MAX};
-  CHECK_RC(scp_enc_components(&b, 7, 0, genus, 4), 0);
+  ASSERT_CODE_EQ(scp_enc_components(&b, 7, 0, genus, 4), 0, scp_err_name);
   d = reparse(&b, SCP_COMPONENTS, &m);
   int32_t gback[4];
-  CHECK_RC(scp_chunk_copy_i32(&m.u.chunk, gback), 0);
+  ASSERT_CODE_EQ(scp_chunk_copy_i32(&m.u.chunk, gback), 0, scp_err_name);
   for (int i = 0; i < 4; i++) {
-    CHECK_INT_EQ(gback[i], genus[i]);
-    CHECK_INT_EQ(scp_chunk_i32(&m.u.chunk, (uint32_t)i), genus[i]);
+    ASSERT_EQ(gback[i], genus[i]);
+    ASSERT_EQ(scp_chunk_i32(&m.u.chunk, (uint32_t)i), genus[i]);
   }
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
@@ -449,37 +457,39 @@ static void test_chunks(void) {
     pt_put32(raw + 4 * i, (uint32_t)(10 * i));
   scp_chunk_t c = {.type = SCP_TRIANGLES, .job_id = 4, .count = 2,
                    .first = 0, .format = SCP_U32_TRIANGLE, .data = raw};
-  CHECK_RC(scp_enc_chunk(&b, &c), 0);
+  ASSERT_CODE_EQ(scp_enc_chunk(&b, &c), 0, scp_err_name);
   d = reparse(&b, SCP_TRIANGLES, &m);
   scp_chunk_triangle(&m.u.chunk, 1, tri);
-  CHECK_U64_EQ(tri[0], 30);
-  CHECK_U64_EQ(tri[2], 50);
+  ASSERT_EQ(tri[0], 30);
+  ASSERT_EQ(tri[2], 50);
   scp_decoder_free(d);
   scp_buf_free(&b);
 }
 
 /* The capacity figures that PROTOCOL.md 6.4 and 7.2 quote. */
 static void test_capacity(void) {
-  CHECK_U64_EQ(scp_chunk_capacity(SCP_U32_TRIANGLE, 4096), 338);
-  CHECK_U64_EQ(scp_chunk_capacity(SCP_F32_XYZ, 4096), 338);
-  CHECK_U64_EQ(scp_chunk_capacity(SCP_F64_XYZ, 4096), 169);
-  CHECK_U64_EQ(scp_chunk_capacity(SCP_I32, 4096), 1016);
-  CHECK_U64_EQ(scp_chunk_capacity(SCP_F64_XYZ, 1u << 20), 43689);
-  CHECK_U64_EQ(scp_chunk_capacity(SCP_U32_TRIANGLE, 1u << 20), 87378);
-  CHECK_U64_EQ(scp_chunk_capacity(99, 1u << 20), 0);
-  CHECK_U64_EQ(scp_chunk_capacity(SCP_I32, 4095), 0);
+  ASSERT_EQ(scp_chunk_capacity(SCP_U32_TRIANGLE, 4096), 338);
+  ASSERT_EQ(scp_chunk_capacity(SCP_F32_XYZ, 4096), 338);
+  ASSERT_EQ(scp_chunk_capacity(SCP_F64_XYZ, 4096), 169);
+  ASSERT_EQ(scp_chunk_capacity(SCP_I32, 4096), 1016);
+  ASSERT_EQ(scp_chunk_capacity(SCP_F64_XYZ, 1u << 20), 43689);
+  ASSERT_EQ(scp_chunk_capacity(SCP_U32_TRIANGLE, 1u << 20), 87378);
+  ASSERT_EQ(scp_chunk_capacity(99, 1u << 20), 0);
+  ASSERT_EQ(scp_chunk_capacity(SCP_I32, 4095), 0);
 
   /* A chunk of exactly the capacity fits the frame limit; one more does
    * not, and leaves the buffer as it was. */
   scp_buf_t b;
   scp_buf_init(&b, 4096);
   double *xyz = calloc(3 * 170, sizeof *xyz);
-  CHECK(xyz != NULL);
-  CHECK_RC(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, xyz, 169), 0);
-  CHECK(b.len <= 4096);
+  ASSERT_NOT_NULL(xyz);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, xyz, 169), 0,
+                 scp_err_name);
+  ASSERT_LE(b.len, 4096);
   size_t len = b.len;
-  CHECK_RC(scp_enc_points(&b, 1, 169, SCP_F64_XYZ, xyz, 170), SCP_ETOOBIG);
-  CHECK_U64_EQ(b.len, len);
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, 169, SCP_F64_XYZ, xyz, 170), SCP_ETOOBIG,
+                 scp_err_name);
+  ASSERT_EQ(b.len, len);
   free(xyz);
   scp_buf_free(&b);
 }
@@ -490,7 +500,7 @@ static void test_points_next(uint32_t max_frame, uint32_t format,
                              uint64_t n) {
   double *xyz = malloc(3 * n * sizeof *xyz);
   double *back = malloc(3 * n * sizeof *back);
-  CHECK(xyz != NULL && back != NULL);
+  ASSERT(xyz != NULL && back != NULL);
   for (uint64_t i = 0; i < 3 * n; i++)
     xyz[i] = (double)i * 0.5; /* exact in float too */
 
@@ -500,32 +510,32 @@ static void test_points_next(uint32_t max_frame, uint32_t format,
   scp_limits_init(&lim);
   lim.max_frame = max_frame;
   scp_decoder_t *d = scp_decoder_new(&lim);
-  CHECK(d != NULL);
+  ASSERT_NOT_NULL(d);
   uint64_t next = 0, got = 0, frames = 0;
   int rc;
   while ((rc = scp_enc_points_next(&b, 3, format, xyz, n, &next)) == 1) {
     /* Flush the buffer into the decoder after every frame, as a caller
      * writing to a socket would. */
-    CHECK_RC(scp_decoder_feed(d, b.data, b.len), 0);
+    ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
     scp_buf_consume(&b, b.len);
     scp_frame_t f;
-    CHECK_RC(scp_decoder_next(d, &f), 1);
-    CHECK(f.length + SCP_HEADER_SIZE <= max_frame);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+    ASSERT_LE(f.length + SCP_HEADER_SIZE, max_frame);
     scp_chunk_t c;
-    CHECK_RC(scp_parse_chunk(&f, &c), 0);
-    CHECK_U64_EQ(c.first, got);
-    CHECK_RC(scp_chunk_copy_xyz(&c, back + 3 * got), 0);
+    ASSERT_CODE_EQ(scp_parse_chunk(&f, &c), 0, scp_err_name);
+    ASSERT_EQ(c.first, got);
+    ASSERT_CODE_EQ(scp_chunk_copy_xyz(&c, back + 3 * got), 0, scp_err_name);
     got += c.count;
     frames++;
-    CHECK_RC(scp_decoder_next(d, &f), 0);
+    ASSERT_CODE_EQ(scp_decoder_next(d, &f), 0, scp_err_name);
   }
-  CHECK_RC(rc, 0);
-  CHECK_U64_EQ(next, n);
-  CHECK_U64_EQ(got, n);
+  ASSERT_CODE_EQ(rc, 0, scp_err_name);
+  ASSERT_EQ(next, n);
+  ASSERT_EQ(got, n);
   uint32_t cap = scp_chunk_capacity(format, max_frame);
-  CHECK_U64_EQ(frames, (n + cap - 1) / cap);
+  ASSERT_EQ(frames, (n + cap - 1) / cap);
   for (uint64_t i = 0; i < 3 * n; i++)
-    CHECK_DBL_SAME(back[i], xyz[i]);
+    ASSERT_DBL_SAME(back[i], xyz[i]);
   scp_decoder_free(d);
   scp_buf_free(&b);
   free(xyz);
@@ -539,7 +549,7 @@ static void test_mesh_next(void) {
   uint32_t *tris = malloc(3 * NT * sizeof *tris);
   double *normals = malloc(3 * NP * sizeof *normals);
   int32_t *genus = malloc(NC * sizeof *genus);
-  CHECK(tris && normals && genus);
+  ASSERT(tris && normals && genus);
   for (uint32_t i = 0; i < 3 * NT; i++)
     tris[i] = (i * 7919u) % NP;
   for (uint32_t i = 0; i < 3 * NP; i++)
@@ -560,49 +570,49 @@ static void test_mesh_next(void) {
   int rc;
   while ((rc = scp_enc_mesh_next(&b, &mv, &cur)) == 1)
     ;
-  CHECK_RC(rc, 0);
+  ASSERT_CODE_EQ(rc, 0, scp_err_name);
 
   scp_decoder_t *d = scp_decoder_new(NULL);
-  CHECK(d != NULL);
-  CHECK_RC(scp_decoder_feed(d, b.data, b.len), 0);
+  ASSERT_NOT_NULL(d);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
   uint64_t seen[3] = {0, 0, 0};
   uint64_t frames = 0;
   scp_frame_t f;
   while ((rc = scp_decoder_next(d, &f)) == 1) {
     scp_chunk_t c;
-    CHECK_RC(scp_parse_chunk(&f, &c), 0);
-    CHECK_U64_EQ(c.job_id, 11);
+    ASSERT_CODE_EQ(scp_parse_chunk(&f, &c), 0, scp_err_name);
+    ASSERT_EQ(c.job_id, 11);
     frames++;
     if (c.type == SCP_TRIANGLES) {
-      CHECK_U64_EQ(seen[1] + seen[2], 0); /* triangles come first */
-      CHECK_U64_EQ(c.first, seen[0]);
+      ASSERT_EQ(seen[1] + seen[2], 0); /* triangles come first */
+      ASSERT_EQ(c.first, seen[0]);
       for (uint32_t i = 0; i < c.count; i++) {
         uint32_t t[3];
         scp_chunk_triangle(&c, i, t);
         for (int k = 0; k < 3; k++)
-          CHECK_U64_EQ(t[k], tris[3 * (c.first + i) + (uint64_t)k]);
+          ASSERT_EQ(t[k], tris[3 * (c.first + i) + (uint64_t)k]);
       }
       seen[0] += c.count;
     } else if (c.type == SCP_NORMALS) {
-      CHECK_U64_EQ(seen[2], 0);
-      CHECK_U64_EQ(c.first, seen[1]);
-      CHECK_U64_EQ(c.format, SCP_F64_XYZ);
+      ASSERT_EQ(seen[2], 0);
+      ASSERT_EQ(c.first, seen[1]);
+      ASSERT_EQ(c.format, SCP_F64_XYZ);
       seen[1] += c.count;
     } else {
-      CHECK_INT_EQ(c.type, SCP_COMPONENTS);
-      CHECK_U64_EQ(c.first, seen[2]);
+      ASSERT_EQ(c.type, SCP_COMPONENTS);
+      ASSERT_EQ(c.first, seen[2]);
       for (uint32_t i = 0; i < c.count; i++)
-        CHECK_INT_EQ(scp_chunk_i32(&c, i), genus[c.first + i]);
+        ASSERT_EQ(scp_chunk_i32(&c, i), genus[c.first + i]);
       seen[2] += c.count;
     }
   }
-  CHECK_RC(rc, 0);
-  CHECK_RC(scp_decoder_eof(d), 0);
-  CHECK_U64_EQ(seen[0], NT);
-  CHECK_U64_EQ(seen[1], NP);
-  CHECK_U64_EQ(seen[2], NC);
+  ASSERT_CODE_EQ(rc, 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_eof(d), 0, scp_err_name);
+  ASSERT_EQ(seen[0], NT);
+  ASSERT_EQ(seen[1], NP);
+  ASSERT_EQ(seen[2], NC);
   /* 338 triangles, 169 f64 normals and 1016 genera per 4 KiB frame. */
-  CHECK_U64_EQ(frames, 3 + 3 + 2);
+  ASSERT_EQ(frames, 3 + 3 + 2);
   scp_decoder_free(d);
   scp_buf_free(&b);
   free(tris);
@@ -623,6 +633,5 @@ int main(void) {
   test_points_next(1u << 20, SCP_F64_XYZ, 100000);
   test_points_next(1u << 20, SCP_F32_XYZ, 1);
   test_mesh_next();
-  pt_done("proto_roundtrip");
-  return 0;
+  return sct_finish("proto_roundtrip");
 }

@@ -11,7 +11,7 @@
  */
 #include <ctype.h>
 
-#include "ptest.h"
+#include "frames.h"
 
 typedef struct example {
   char dir;       /* 'C' or 'S' */
@@ -44,7 +44,7 @@ static int hex_line(const char *s, example_t *e) {
       e->len = start;
       return 0;
     }
-    CHECK(e->len < sizeof e->bytes);
+    ASSERT_LT(e->len, sizeof e->bytes);
     e->bytes[e->len++] = (uint8_t)(hi << 4 | lo);
     s += 2;
   }
@@ -55,7 +55,7 @@ static int hex_line(const char *s, example_t *e) {
 static size_t read_examples(const char *path, example_t *out, size_t max) {
   FILE *fp = fopen(path, "r");
   if (!fp)
-    PT_FAIL_("cannot open %s", path);
+    ASSERT_FAIL("cannot open %s", path);
   char line[512];
   int in_section = 0;
   size_t n = 0;
@@ -69,7 +69,7 @@ static size_t read_examples(const char *path, example_t *out, size_t max) {
     if (!in_section)
       continue;
     if ((line[0] == 'C' || line[0] == 'S') && line[1] == ':') {
-      CHECK(n < max);
+      ASSERT_LT(n, max);
       cur = &out[n];
       memset(cur, 0, sizeof *cur);
       cur->dir = line[0];
@@ -80,9 +80,9 @@ static size_t read_examples(const char *path, example_t *out, size_t max) {
       while ((isupper((unsigned char)*p) || *p == '_') &&
              k < sizeof cur->name - 1)
         cur->name[k++] = *p++;
-      CHECK(k > 0);
+      ASSERT_GT(k, 0);
       if (!hex_line(p, cur))
-        PT_FAIL_("example %s: no bytes on its first line", cur->name);
+        ASSERT_FAIL("example %s: no bytes on its first line", cur->name);
       n++;
       continue;
     }
@@ -98,38 +98,38 @@ static void expected(scp_buf_t *b, const char *name) {
   if (strcmp(name, "HELLO") == 0) {
     scp_hello_t h = {.version_min = 1, .version_max = 1, .features = 0,
                      .max_frame = 1u << 20};
-    CHECK_RC(scp_enc_hello(b, &h), 0);
+    ASSERT_CODE_EQ(scp_enc_hello(b, &h), 0, scp_err_name);
   } else if (strcmp(name, "WELCOME") == 0) {
     scp_welcome_t w = {.version = 1, .features = 0, .max_frame = 1u << 20,
                        .max_jobs = 8, .max_points = 10000000};
-    CHECK_RC(scp_enc_welcome(b, &w), 0);
+    ASSERT_CODE_EQ(scp_enc_welcome(b, &w), 0, scp_err_name);
   } else if (strcmp(name, "JOB_BEGIN") == 0) {
     scp_job_begin_t jb = {.job_id = 7, .mode = SCP_MODE_COCONE, .r = 0.25,
                           .theta = 0, .point_count = 4,
                           .flags = SCP_JOB_NORMALS};
-    CHECK_RC(scp_enc_job_begin(b, &jb), 0);
+    ASSERT_CODE_EQ(scp_enc_job_begin(b, &jb), 0, scp_err_name);
   } else if (strcmp(name, "POINTS") == 0) {
     float p[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
-    CHECK_RC(scp_enc_points_f32(b, 7, 0, p, 4), 0);
+    ASSERT_CODE_EQ(scp_enc_points_f32(b, 7, 0, p, 4), 0, scp_err_name);
   } else if (strcmp(name, "JOB_END") == 0) {
     scp_job_end_t je = {.job_id = 7, .point_count = 4};
-    CHECK_RC(scp_enc_job_end(b, &je), 0);
+    ASSERT_CODE_EQ(scp_enc_job_end(b, &je), 0, scp_err_name);
   } else if (strcmp(name, "ACCEPTED") == 0) {
     scp_accepted_t a = {.job_id = 7, .queue_position = 0};
-    CHECK_RC(scp_enc_accepted(b, &a), 0);
+    ASSERT_CODE_EQ(scp_enc_accepted(b, &a), 0, scp_err_name);
   } else if (strcmp(name, "TRIANGLES") == 0) {
     uint32_t t[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
-    CHECK_RC(scp_enc_triangles(b, 7, 0, t, 4), 0);
+    ASSERT_CODE_EQ(scp_enc_triangles(b, 7, 0, t, 4), 0, scp_err_name);
   } else if (strcmp(name, "COMPONENTS") == 0) {
     int32_t genus[1] = {0};
-    CHECK_RC(scp_enc_components(b, 7, 0, genus, 1), 0);
+    ASSERT_CODE_EQ(scp_enc_components(b, 7, 0, genus, 1), 0, scp_err_name);
   } else if (strcmp(name, "JOB_DONE") == 0) {
     scp_value_t v = {.name = "triangles", .kind = SCP_KIND_U64, .v.u = 4};
     scp_job_done_t jd = {.job_id = 7, .triangles = 4, .normals = 4,
                          .components = 1};
-    CHECK_RC(scp_enc_job_done(b, &jd, &v, 1), 0);
+    ASSERT_CODE_EQ(scp_enc_job_done(b, &jd, &v, 1), 0, scp_err_name);
   } else {
-    PT_FAIL_("example %s is not known to this test", name);
+    ASSERT_FAIL("example %s is not known to this test", name);
   }
 }
 
@@ -141,14 +141,14 @@ static void check_tetrahedron(const scp_chunk_t *c) {
     uint32_t t[3];
     scp_chunk_triangle(c, i, t);
     for (int k = 0; k < 3; k++) {
-      CHECK(t[k] < 4);
+      ASSERT_LT(t[k], 4);
       used[t[k]][t[(k + 1) % 3]]++;
     }
   }
   for (int a = 0; a < 4; a++)
     for (int b2 = 0; b2 < 4; b2++)
       if (a != b2)
-        CHECK_INT_EQ(used[a][b2], 1);
+        ASSERT_EQ(used[a][b2], 1);
 }
 
 int main(int argc, char **argv) {
@@ -161,30 +161,31 @@ int main(int argc, char **argv) {
   static const char *const order[] = {
       "HELLO",    "WELCOME",   "JOB_BEGIN",  "POINTS",  "JOB_END",
       "ACCEPTED", "TRIANGLES", "COMPONENTS", "JOB_DONE"};
-  CHECK_U64_EQ(n, sizeof order / sizeof order[0]);
+  ASSERT_EQ(n, sizeof order / sizeof order[0]);
   scp_job_begin_t begin = {0};
   uint64_t triangles = 0, components = 0;
 
   for (size_t i = 0; i < n; i++) {
-    CHECK_STR_EQ(ex[i].name, order[i]);
+    ASSERT_STR_EQ(ex[i].name, order[i]);
     scp_buf_t b;
     scp_buf_init(&b, 1u << 20);
     expected(&b, ex[i].name);
     if (b.len != ex[i].len || memcmp(b.data, ex[i].bytes, b.len) != 0)
       fprintf(stderr, "example %s differs from the encoder\n", ex[i].name);
-    CHECK_MEM_EQ(ex[i].bytes, ex[i].len, b.data, b.len);
+    ASSERT_MEM_EQ(ex[i].bytes, ex[i].len, b.data, b.len);
 
     /* The direction in the document matches who may send the type. */
     scp_frame_t f;
     scp_decoder_t *d = pt_decode_one(ex[i].bytes, ex[i].len, &f);
-    CHECK_STR_EQ(scp_type_name(f.type), ex[i].name);
+    ASSERT_STR_EQ(scp_type_name(f.type), ex[i].name);
     int from = ex[i].dir == 'C' ? SCP_FROM_CLIENT : SCP_FROM_SERVER;
-    CHECK(scp_type_senders(f.type) & from);
+    ASSERT(scp_type_senders(f.type) & from);
     scp_msg_t m;
-    CHECK_RC(scp_parse_as(&f, from == SCP_FROM_CLIENT ? SCP_ROLE_SERVER
-                                                      : SCP_ROLE_CLIENT,
-                          &m),
-             0);
+    ASSERT_CODE_EQ(scp_parse_as(&f,
+                                from == SCP_FROM_CLIENT ? SCP_ROLE_SERVER
+                                                        : SCP_ROLE_CLIENT,
+                                &m),
+                   0, scp_err_name);
     /* The examples form one job, so they must obey the job rules too. */
     if (f.type == SCP_JOB_BEGIN)
       begin = m.u.job_begin;
@@ -195,20 +196,18 @@ int main(int argc, char **argv) {
     if (f.type == SCP_COMPONENTS)
       components += m.u.chunk.count;
     if (f.type == SCP_JOB_DONE) {
-      CHECK_U64_EQ(m.u.job_done.job_id, begin.job_id);
-      CHECK_U64_EQ(m.u.job_done.triangles, triangles);
-      CHECK_U64_EQ(m.u.job_done.components, components);
-      CHECK_U64_EQ(m.u.job_done.normals, (begin.flags & SCP_JOB_NORMALS)
-                                             ? begin.point_count
-                                             : 0);
+      ASSERT_EQ(m.u.job_done.job_id, begin.job_id);
+      ASSERT_EQ(m.u.job_done.triangles, triangles);
+      ASSERT_EQ(m.u.job_done.components, components);
+      ASSERT_EQ(m.u.job_done.normals,
+                (begin.flags & SCP_JOB_NORMALS) ? begin.point_count : 0);
       scp_value_iter_t it;
       scp_value_t v;
-      CHECK(scp_values_find(&m.u.job_done.values, "triangles", &it, &v));
-      CHECK_U64_EQ(v.v.u, m.u.job_done.triangles);
+      ASSERT(scp_values_find(&m.u.job_done.values, "triangles", &it, &v));
+      ASSERT_EQ(v.v.u, m.u.job_done.triangles);
     }
     scp_decoder_free(d);
     scp_buf_free(&b);
   }
-  pt_done("proto_spec");
-  return 0;
+  return sct_finish("proto_spec");
 }

@@ -6,7 +6,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "ptest.h"
+#include "frames.h"
 
 typedef struct expect {
   uint16_t type;
@@ -30,7 +30,7 @@ static void append(stream_t *s, const uint8_t *p, size_t n) {
     while (cap < s->len + n)
       cap *= 2;
     s->bytes = realloc(s->bytes, cap);
-    CHECK(s->bytes != NULL);
+    ASSERT_NOT_NULL(s->bytes);
     s->cap = cap;
   }
   memcpy(s->bytes + s->len, p, n);
@@ -41,18 +41,18 @@ static void append(stream_t *s, const uint8_t *p, size_t n) {
 static void take(stream_t *s, scp_buf_t *b) {
   size_t at = 0;
   while (at < b->len) {
-    CHECK(b->len - at >= SCP_HEADER_SIZE);
+    ASSERT_GE(b->len - at, SCP_HEADER_SIZE);
     uint16_t type = (uint16_t)(b->data[at] | b->data[at + 1] << 8);
     uint32_t length = (uint32_t)b->data[at + 4] |
                       (uint32_t)b->data[at + 5] << 8 |
                       (uint32_t)b->data[at + 6] << 16 |
                       (uint32_t)b->data[at + 7] << 24;
     s->frames = realloc(s->frames, (s->n + 1) * sizeof *s->frames);
-    CHECK(s->frames != NULL);
+    ASSERT_NOT_NULL(s->frames);
     s->frames[s->n++] = (expect_t){type, length, s->len + at};
     at += SCP_HEADER_SIZE + length;
   }
-  CHECK_U64_EQ(at, b->len);
+  ASSERT_EQ(at, b->len);
   append(s, b->data, b->len);
   scp_buf_consume(b, b->len);
 }
@@ -75,7 +75,7 @@ static void unknown(stream_t *s, uint16_t type, uint32_t length) {
   uint8_t h[SCP_HEADER_SIZE];
   pt_header(h, type, 0, length);
   s->frames = realloc(s->frames, (s->n + 1) * sizeof *s->frames);
-  CHECK(s->frames != NULL);
+  ASSERT_NOT_NULL(s->frames);
   s->frames[s->n++] = (expect_t){type, length, s->len};
   append(s, h, sizeof h);
   for (uint32_t i = 0; i < length; i++) {
@@ -97,38 +97,38 @@ static void build_client_stream(stream_t *s, int pieces) {
   memset(s, 0, sizeof *s);
   s->role = SCP_ROLE_SERVER;
   scp_hello_t h = {.version_min = 1, .version_max = 1, .max_frame = 4096};
-  CHECK_RC(scp_enc_hello(&b, &h), 0);
+  ASSERT_CODE_EQ(scp_enc_hello(&b, &h), 0, scp_err_name);
   take(s, &b);
   ignorable(s, 0x8001, 0);
   scp_job_begin_t jb = {.job_id = 7, .mode = 1, .r = 0.25, .point_count = 40,
                         .flags = SCP_JOB_NORMALS};
-  CHECK_RC(scp_enc_job_begin(&b, &jb), 0);
+  ASSERT_CODE_EQ(scp_enc_job_begin(&b, &jb), 0, scp_err_name);
   take(s, &b);
   double xyz[3 * 40];
   for (int i = 0; i < 120; i++)
     xyz[i] = i * 0.25;
   for (int k = 0; k < pieces; k++) {
     uint32_t count = 40 / (uint32_t)pieces;
-    CHECK_RC(scp_enc_points(&b, 7, (uint64_t)k * count,
-                            k % 2 ? SCP_F32_XYZ : SCP_F64_XYZ,
-                            xyz + 3 * k * count, count),
-             0);
+    ASSERT_CODE_EQ(scp_enc_points(&b, 7, (uint64_t)k * count,
+                                  k % 2 ? SCP_F32_XYZ : SCP_F64_XYZ,
+                                  xyz + 3 * k * count, count),
+                   0, scp_err_name);
     take(s, &b);
     if (k == 0)
       ignorable(s, 0xFFFF, 13);
   }
-  CHECK_RC(scp_enc_ping(&b, 99), 0);
+  ASSERT_CODE_EQ(scp_enc_ping(&b, 99), 0, scp_err_name);
   unknown(s, 0x0099, 3);
   unknown(s, 0x0000, 0);
-  CHECK_RC(scp_enc_stats_request(&b, 5), 0);
+  ASSERT_CODE_EQ(scp_enc_stats_request(&b, 5), 0, scp_err_name);
   scp_job_end_t je = {.job_id = 7, .point_count = 40};
-  CHECK_RC(scp_enc_job_end(&b, &je), 0);
+  ASSERT_CODE_EQ(scp_enc_job_end(&b, &je), 0, scp_err_name);
   jb.job_id = 8;
-  CHECK_RC(scp_enc_job_begin(&b, &jb), 0);
-  CHECK_RC(scp_enc_cancel(&b, 8), 0);
+  ASSERT_CODE_EQ(scp_enc_job_begin(&b, &jb), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_cancel(&b, 8), 0, scp_err_name);
   scp_error_t e = {.code = SCP_WIRE_UNKNOWN_TYPE, .ref_type = 0x8123};
   strcpy(e.message, "?");
-  CHECK_RC(scp_enc_error(&b, &e), 0);
+  ASSERT_CODE_EQ(scp_enc_error(&b, &e), 0, scp_err_name);
   take(s, &b);
   ignorable(s, 0x8fff, 1);
   scp_buf_free(&b);
@@ -144,29 +144,29 @@ static void build_server_stream(stream_t *s) {
   s->role = SCP_ROLE_CLIENT;
   scp_welcome_t w = {.version = 1, .max_frame = 1u << 16, .max_jobs = 4,
                      .max_points = 1000000};
-  CHECK_RC(scp_enc_welcome(&b, &w), 0);
+  ASSERT_CODE_EQ(scp_enc_welcome(&b, &w), 0, scp_err_name);
   scp_accepted_t a = {.job_id = 1, .queue_position = 2};
-  CHECK_RC(scp_enc_accepted(&b, &a), 0);
+  ASSERT_CODE_EQ(scp_enc_accepted(&b, &a), 0, scp_err_name);
   scp_progress_t pr = {.job_id = 1, .stage = 1, .fraction = 0.5};
-  CHECK_RC(scp_enc_progress(&b, &pr), 0);
+  ASSERT_CODE_EQ(scp_enc_progress(&b, &pr), 0, scp_err_name);
   take(s, &b);
   ignorable(s, 0x9000, 5000); /* larger than 4 KiB: skipped, not buffered */
   uint32_t tris[3 * 1000];
   for (uint32_t i = 0; i < 3 * 1000; i++)
     tris[i] = i;
-  CHECK_RC(scp_enc_triangles(&b, 1, 0, tris, 1000), 0);
-  CHECK_RC(scp_enc_triangles(&b, 1, 1000, tris, 1), 0);
+  ASSERT_CODE_EQ(scp_enc_triangles(&b, 1, 0, tris, 1000), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_triangles(&b, 1, 1000, tris, 1), 0, scp_err_name);
   int32_t g[2] = {0, -1};
-  CHECK_RC(scp_enc_components(&b, 1, 0, g, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_components(&b, 1, 0, g, 2), 0, scp_err_name);
   scp_value_t v[2] = {{.name = "triangles", .kind = SCP_KIND_U64, .v.u = 1001},
                       {.name = "genus", .kind = SCP_KIND_I64, .v.i = 0}};
   scp_job_done_t jd = {.job_id = 1, .triangles = 1001, .components = 2};
-  CHECK_RC(scp_enc_job_done(&b, &jd, v, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_job_done(&b, &jd, v, 2), 0, scp_err_name);
   scp_job_error_t je = {.job_id = 2, .code = SCP_WIRE_BUSY};
   strcpy(je.message, "queue full");
-  CHECK_RC(scp_enc_job_error(&b, &je), 0);
-  CHECK_RC(scp_enc_pong(&b, 99), 0);
-  CHECK_RC(scp_enc_stats(&b, 5, v, 2), 0);
+  ASSERT_CODE_EQ(scp_enc_job_error(&b, &je), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_pong(&b, 99), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_stats(&b, 5, v, 2), 0, scp_err_name);
   take(s, &b);
   scp_buf_free(&b);
 }
@@ -180,19 +180,20 @@ static void build_many(stream_t *s, int count) {
   for (int i = 0; i < count; i++) {
     switch (i % 4) {
     case 0:
-      CHECK_RC(scp_enc_ping(&b, (uint64_t)i), 0);
+      ASSERT_CODE_EQ(scp_enc_ping(&b, (uint64_t)i), 0, scp_err_name);
       break;
     case 1:
-      CHECK_RC(scp_enc_cancel(&b, (uint32_t)i), 0);
+      ASSERT_CODE_EQ(scp_enc_cancel(&b, (uint32_t)i), 0, scp_err_name);
       break;
     case 2: {
       double p[3] = {i, -i, 0.5};
-      CHECK_RC(scp_enc_points(&b, 1, (uint64_t)i, SCP_F64_XYZ, p, 1), 0);
+      ASSERT_CODE_EQ(scp_enc_points(&b, 1, (uint64_t)i, SCP_F64_XYZ, p, 1), 0,
+                     scp_err_name);
       break;
     }
     default: {
       scp_accepted_t a = {.job_id = (uint32_t)i, .queue_position = 0};
-      CHECK_RC(scp_enc_accepted(&b, &a), 0);
+      ASSERT_CODE_EQ(scp_enc_accepted(&b, &a), 0, scp_err_name);
       break;
     }
     }
@@ -211,24 +212,25 @@ static void drain(scp_decoder_t *d, const stream_t *s, size_t *seen) {
   int rc;
   while ((rc = scp_decoder_next(d, &f)) == 1) {
     if (*seen >= s->n)
-      PT_FAIL_("frame %zu (type 0x%04x) beyond the %zu expected", *seen,
-               f.type, s->n);
+      ASSERT_FAIL("frame %zu (type 0x%04x) beyond the %zu expected", *seen,
+                  f.type, s->n);
     const expect_t *e = &s->frames[*seen];
     if (f.type != e->type || f.length != e->length ||
         memcmp(f.payload, s->bytes + e->offset + SCP_HEADER_SIZE,
                f.length) != 0)
-      PT_FAIL_("frame %zu: got type 0x%04x length %u, expected type 0x%04x "
-               "length %u at offset %zu",
-               *seen, f.type, f.length, e->type, e->length, e->offset);
+      ASSERT_FAIL("frame %zu: got type 0x%04x length %u, expected type 0x%04x "
+                  "length %u at offset %zu",
+                  *seen, f.type, f.length, e->type, e->length, e->offset);
     if (f.type == SCP_WELCOME) {
       scp_welcome_t w;
-      CHECK_RC(scp_parse_welcome(&f, &w), 0);
-      CHECK_RC(scp_decoder_set_max_frame(d, w.max_frame), 0);
+      ASSERT_CODE_EQ(scp_parse_welcome(&f, &w), 0, scp_err_name);
+      ASSERT_CODE_EQ(scp_decoder_set_max_frame(d, w.max_frame), 0,
+                     scp_err_name);
     }
     (*seen)++;
   }
   if (rc != 0)
-    PT_FAIL_("decoder error %s after %zu frames", scp_err_name(rc), *seen);
+    ASSERT_FAIL("decoder error %s after %zu frames", scp_err_name(rc), *seen);
 }
 
 /* Feeds the stream cut at cuts[0] < cuts[1] < ... (each inside the
@@ -239,28 +241,28 @@ static void run(const stream_t *s, const size_t *cuts, size_t ncuts,
   scp_limits_init(&lim);
   lim.role = s->role;
   scp_decoder_t *d = scp_decoder_new(&lim);
-  CHECK(d != NULL);
+  ASSERT_NOT_NULL(d);
   runs_++;
   size_t seen = 0, at = 0;
   for (size_t i = 0; i <= ncuts; i++) {
     size_t to = i < ncuts ? cuts[i] : s->len;
     int rc = scp_decoder_feed(d, s->bytes + at, to - at);
     if (rc != 0)
-      PT_FAIL_("feed [%zu, %zu): %s", at, to, scp_err_name(rc));
+      ASSERT_FAIL("feed [%zu, %zu): %s", at, to, scp_err_name(rc));
     at = to;
     if (drain_each)
       drain(d, s, &seen);
   }
   drain(d, s, &seen);
   if (seen != s->n)
-    PT_FAIL_("%zu frames decoded, %zu expected", seen, s->n);
-  CHECK_RC(scp_decoder_eof(d), 0);
-  CHECK_U64_EQ(scp_decoder_pending(d), 0);
+    ASSERT_FAIL("%zu frames decoded, %zu expected", seen, s->n);
+  ASSERT_CODE_EQ(scp_decoder_eof(d), 0, scp_err_name);
+  ASSERT_EQ(scp_decoder_pending(d), 0);
   scp_decoder_counters_t c;
   scp_decoder_get_counters(d, &c);
-  CHECK_U64_EQ(c.frames, s->n);
-  CHECK_U64_EQ(c.bytes, s->len);
-  CHECK_U64_EQ(c.skipped, s->skipped);
+  ASSERT_EQ(c.frames, s->n);
+  ASSERT_EQ(c.bytes, s->len);
+  ASSERT_EQ(c.skipped, s->skipped);
   scp_decoder_free(d);
 }
 
@@ -288,7 +290,7 @@ static void every_pair(const stream_t *s) {
 
 static void byte_at_a_time(const stream_t *s) {
   size_t *cuts = malloc(s->len * sizeof *cuts);
-  CHECK(cuts != NULL);
+  ASSERT_NOT_NULL(cuts);
   for (size_t i = 1; i < s->len; i++)
     cuts[i - 1] = i;
   run(s, cuts, s->len - 1, 1);
@@ -298,7 +300,7 @@ static void byte_at_a_time(const stream_t *s) {
 
 static void random_pieces(const stream_t *s, int rounds, uint64_t seed) {
   size_t *cuts = malloc(s->len * sizeof *cuts);
-  CHECK(cuts != NULL);
+  ASSERT_NOT_NULL(cuts);
   for (int r = 0; r < rounds; r++) {
     size_t n = 0, at = 0;
     /* Pieces from 1 byte to a few frames, so that cuts fall inside
@@ -347,6 +349,5 @@ int main(void) {
   stream_free(&s);
 
   printf("%lu decoder runs over %lu streams\n", runs_, streams_);
-  pt_done("proto_split");
-  return 0;
+  return sct_finish("proto_split");
 }

@@ -10,8 +10,13 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include <ctype.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
-#include "ptest.h"
+#include "sct_assert.h"
+#include "scproto.h"
 
 /* Splits a markdown table row into at most max trimmed cells; returns the
  * number of cells, or 0 for a line that is not a row. */
@@ -46,26 +51,26 @@ static void check_row(const char *section, char **c, int n,
   if (strncmp(section, "### 3.2", 7) == 0 && n >= 3 &&
       strncmp(c[0], "0x", 2) == 0) {
     unsigned long type = strtoul(c[0], &end, 16);
-    CHECK(*end == '\0');
-    CHECK_STR_EQ(scp_type_name((uint16_t)type), c[1]);
+    ASSERT_EQ(*end, '\0');
+    ASSERT_STR_EQ(scp_type_name((uint16_t)type), c[1]);
     int want = 0;
     if (strchr(c[2], 'C'))
       want |= SCP_FROM_CLIENT;
     if (strchr(c[2], 'S'))
       want |= SCP_FROM_SERVER;
-    CHECK_INT_EQ(scp_type_senders((uint16_t)type), want);
+    ASSERT_EQ(scp_type_senders((uint16_t)type), want);
     seen->types++;
   } else if (strncmp(section, "## 9.", 5) == 0 && n >= 2 &&
              isdigit((unsigned char)c[0][0])) {
     unsigned long code = strtoul(c[0], &end, 10);
-    CHECK(*end == '\0');
-    CHECK_STR_EQ(scp_wire_name((uint32_t)code), c[1]);
-    CHECK(strcmp(scp_wire_strerror((uint32_t)code), "unknown error") != 0);
+    ASSERT_EQ(*end, '\0');
+    ASSERT_STR_EQ(scp_wire_name((uint32_t)code), c[1]);
+    ASSERT_STR_NE(scp_wire_strerror((uint32_t)code), "unknown error");
     seen->errors++;
   } else if (strncmp(section, "## 4.", 5) == 0 && n >= 2 &&
              isdigit((unsigned char)c[0][0])) {
     unsigned long v = strtoul(c[0], &end, 10);
-    CHECK(*end == '\0');
+    ASSERT_EQ(*end, '\0');
     /* Section 4 holds three tables of value/name; tell them apart by the
      * name, which each table's library function knows. */
     if (strcmp(scp_mode_name((uint32_t)v), c[1]) == 0 &&
@@ -76,13 +81,13 @@ static void check_row(const char *section, char **c, int n,
       seen->stages++;
     } else {
       /* value | name | element | size */
-      CHECK(n >= 4);
-      CHECK(scp_format_size((uint32_t)v) > 0);
-      CHECK_U64_EQ(scp_format_size((uint32_t)v), strtoul(c[3], NULL, 10));
+      ASSERT_GE(n, 4);
+      ASSERT_GT(scp_format_size((uint32_t)v), 0);
+      ASSERT_EQ(scp_format_size((uint32_t)v), strtoul(c[3], NULL, 10));
       static const char *const fmt[] = {NULL, "F32_XYZ", "F64_XYZ",
                                         "U32_TRIANGLE", "I32"};
-      CHECK(v >= 1 && v <= 4);
-      CHECK_STR_EQ(c[1], fmt[v]);
+      ASSERT(v >= 1 && v <= 4);
+      ASSERT_STR_EQ(c[1], fmt[v]);
       seen->formats++;
     }
   }
@@ -91,7 +96,7 @@ static void check_row(const char *section, char **c, int n,
 static void check_document(const char *path) {
   FILE *fp = fopen(path, "r");
   if (!fp)
-    PT_FAIL_("cannot open %s", path);
+    ASSERT_FAIL("cannot open %s", path);
   char line[512], section[sizeof line] = "";
   section_rows_t seen = {0, 0, 0, 0, 0};
   while (fgets(line, sizeof line, fp)) {
@@ -105,11 +110,11 @@ static void check_document(const char *path) {
       check_row(section, cells, n, &seen);
   }
   fclose(fp);
-  CHECK_INT_EQ(seen.types, 18);
-  CHECK_INT_EQ(seen.errors, 17);
-  CHECK_INT_EQ(seen.modes, SCP_MODE_COUNT);
-  CHECK_INT_EQ(seen.stages, SCP_STAGE_COUNT);
-  CHECK_INT_EQ(seen.formats, 4);
+  ASSERT_EQ(seen.types, 18);
+  ASSERT_EQ(seen.errors, 17);
+  ASSERT_EQ(seen.modes, SCP_MODE_COUNT);
+  ASSERT_EQ(seen.stages, SCP_STAGE_COUNT);
+  ASSERT_EQ(seen.formats, 4);
 }
 
 static void check_library_codes(void) {
@@ -135,38 +140,38 @@ static void check_library_codes(void) {
   };
   size_t n = sizeof want / sizeof want[0];
   for (size_t i = 0; i < n; i++) {
-    CHECK(want[i].code < 0);
-    CHECK_STR_EQ(scp_err_name(want[i].code), want[i].name);
-    CHECK(strcmp(scp_strerror(want[i].code), "unknown error") != 0);
-    CHECK_U64_EQ(scp_err_to_wire(want[i].code), want[i].wire);
-    CHECK_INT_EQ(scp_err_is_fatal(want[i].code), want[i].fatal);
+    ASSERT_LT(want[i].code, 0);
+    ASSERT_STR_EQ(scp_err_name(want[i].code), want[i].name);
+    ASSERT_STR_NE(scp_strerror(want[i].code), "unknown error");
+    ASSERT_EQ(scp_err_to_wire(want[i].code), want[i].wire);
+    ASSERT_EQ(scp_err_is_fatal(want[i].code), want[i].fatal);
     for (size_t j = 0; j < i; j++)
-      CHECK(want[i].code != want[j].code);
+      ASSERT_NE(want[i].code, want[j].code);
   }
   /* Codes the table lacks: unknown, and fatal to be safe. */
-  CHECK_STR_EQ(scp_err_name(-1000), "UNKNOWN");
-  CHECK_STR_EQ(scp_strerror(-1000), "unknown error");
-  CHECK_U64_EQ(scp_err_to_wire(-1000), SCP_WIRE_INTERNAL);
-  CHECK_INT_EQ(scp_err_is_fatal(-1000), 1);
-  CHECK_STR_EQ(scp_err_name(0), "OK");
-  CHECK_INT_EQ(scp_err_is_fatal(0), 0);
+  ASSERT_STR_EQ(scp_err_name(-1000), "UNKNOWN");
+  ASSERT_STR_EQ(scp_strerror(-1000), "unknown error");
+  ASSERT_EQ(scp_err_to_wire(-1000), SCP_WIRE_INTERNAL);
+  ASSERT_EQ(scp_err_is_fatal(-1000), 1);
+  ASSERT_STR_EQ(scp_err_name(0), "OK");
+  ASSERT_EQ(scp_err_is_fatal(0), 0);
 
   /* Wire codes this version does not define must still be accepted and
    * shown (section 9). */
-  CHECK_STR_EQ(scp_wire_name(0), "UNKNOWN");
-  CHECK_STR_EQ(scp_wire_name(18), "UNKNOWN");
-  CHECK_STR_EQ(scp_wire_strerror(0xFFFFFFFFu), "unknown error");
+  ASSERT_STR_EQ(scp_wire_name(0), "UNKNOWN");
+  ASSERT_STR_EQ(scp_wire_name(18), "UNKNOWN");
+  ASSERT_STR_EQ(scp_wire_strerror(0xFFFFFFFFu), "unknown error");
 
   /* Names outside the tables. */
-  CHECK_STR_EQ(scp_type_name(0), "?");
-  CHECK_STR_EQ(scp_type_name(0x8000), "?");
-  CHECK_INT_EQ(scp_type_senders(0x8000), 0);
-  CHECK_STR_EQ(scp_mode_name(SCP_MODE_COUNT), "?");
-  CHECK_STR_EQ(scp_stage_name(SCP_STAGE_COUNT), "?");
-  CHECK_STR_EQ(scp_stage_name(SCP_STAGE_UPLOAD), "upload");
-  CHECK_STR_EQ(scp_stage_name(SCP_STAGE_DOWNLOAD), "download");
-  CHECK_U64_EQ(scp_format_size(0), 0);
-  CHECK_U64_EQ(scp_format_size(5), 0);
+  ASSERT_STR_EQ(scp_type_name(0), "?");
+  ASSERT_STR_EQ(scp_type_name(0x8000), "?");
+  ASSERT_EQ(scp_type_senders(0x8000), 0);
+  ASSERT_STR_EQ(scp_mode_name(SCP_MODE_COUNT), "?");
+  ASSERT_STR_EQ(scp_stage_name(SCP_STAGE_COUNT), "?");
+  ASSERT_STR_EQ(scp_stage_name(SCP_STAGE_UPLOAD), "upload");
+  ASSERT_STR_EQ(scp_stage_name(SCP_STAGE_DOWNLOAD), "download");
+  ASSERT_EQ(scp_format_size(0), 0);
+  ASSERT_EQ(scp_format_size(5), 0);
 }
 
 int main(int argc, char **argv) {
@@ -176,6 +181,5 @@ int main(int argc, char **argv) {
   }
   check_document(argv[1]);
   check_library_codes();
-  pt_done("proto_tables");
-  return 0;
+  return sct_finish("proto_tables");
 }

@@ -1,7 +1,7 @@
 /*
- * How the samples are spaced, against what testsupport.h promises and what
+ * How the samples are spaced, against what synth.h promises and what
  * theory says, measured by each point's nearest-neighbour distance in units
- * of sc_surface_spacing() (sqrt(area / n)):
+ * of scs_surface_spacing() (sqrt(area / n)):
  *
  *  - UNIFORM is well spaced on every surface: no two points closer than
  *    0.63 units, the median 0.76 to 0.80, none above 1.45. (Measured: at
@@ -19,9 +19,11 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "testsupport.h"
-#include "tsassert.h"
+#include "sct_assert.h"
+#include "synth.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -145,51 +147,52 @@ static stats_t stats_of(double *v, size_t n, double unit) {
   return (stats_t){v[0] / unit, v[n / 2] / unit, v[n - 1] / unit};
 }
 
-static double *sample(sc_surface_t s, int d, size_t n, uint64_t seed) {
+static double *sample(scs_surface_t s, int d, size_t n, uint64_t seed) {
   double *xyz = malloc(3 * n * sizeof *xyz);
   if (!xyz)
     abort();
-  TS_EQ_I64(sc_sample_surface(s, d, n, seed, xyz), SC_TS_OK);
+  EXPECT_EQ(scs_sample_surface(s, d, n, seed, xyz), SCS_OK);
   return xyz;
 }
 
 /* The well-spaced band of UNIFORM, and of ADAPTIVE where it is uniform. */
-static void check_spaced(sc_surface_t s, int d, size_t n, uint64_t seed) {
+static void check_spaced(scs_surface_t s, int d, size_t n, uint64_t seed) {
   double *xyz = sample(s, d, n, seed);
-  double unit = sc_surface_spacing(s, n);
+  double unit = scs_surface_spacing(s, n);
   double *nn = nearest(xyz, n, unit);
   stats_t st = stats_of(nn, n, unit);
-  TS_TRUE(st.min >= 0.63 && st.median >= 0.76 && st.median <= 0.80 &&
-              st.max <= 1.45,
-          "%s/%s n=%zu: nearest neighbours min %.3f median %.3f max %.3f",
-          sc_surface_name(s), sc_density_name(d), n, st.min, st.median, st.max);
+  EXPECT_MSG(st.min >= 0.63 && st.median >= 0.76 && st.median <= 0.80 &&
+                 st.max <= 1.45,
+             "%s/%s n=%zu: nearest neighbours min %.3f median %.3f max %.3f",
+             scs_surface_name(s), scs_density_name(d), n, st.min, st.median,
+             st.max);
   free(nn);
   free(xyz);
 }
 
 static void test_uniform(void) {
-  for (int s = 0; s < SC_SURF_COUNT; s++)
-    check_spaced((sc_surface_t)s, SC_DENSITY_UNIFORM, 4000, 5);
+  for (int s = 0; s < SCS_SURF_COUNT; s++)
+    check_spaced((scs_surface_t)s, SCS_DENSITY_UNIFORM, 4000, 5);
   /* Small and larger samples alike. */
-  check_spaced(SC_SURF_SPHERE, SC_DENSITY_UNIFORM, 300, 6);
-  check_spaced(SC_SURF_TORUS, SC_DENSITY_UNIFORM, 30000, 7);
+  check_spaced(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM, 300, 6);
+  check_spaced(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, 30000, 7);
   /* Constant curvature: ADAPTIVE has nothing to adapt to. */
-  check_spaced(SC_SURF_SPHERE, SC_DENSITY_ADAPTIVE, 4000, 5);
-  check_spaced(SC_SURF_TWO_SPHERES, SC_DENSITY_ADAPTIVE, 4000, 5);
-  check_spaced(SC_SURF_TORUS, SC_DENSITY_ADAPTIVE, 4000, 5);
+  check_spaced(SCS_SURF_SPHERE, SCS_DENSITY_ADAPTIVE, 4000, 5);
+  check_spaced(SCS_SURF_TWO_SPHERES, SCS_DENSITY_ADAPTIVE, 4000, 5);
+  check_spaced(SCS_SURF_TORUS, SCS_DENSITY_ADAPTIVE, 4000, 5);
 }
 
 /* A Poisson sample of density n / A: P(nn > r) = exp(-pi r^2 n / A). */
 static void test_random(void) {
   const double median = 0.46971863934982566; /* sqrt(ln 2 / pi) */
-  for (int s = 0; s < SC_SURF_COUNT; s++) {
+  for (int s = 0; s < SCS_SURF_COUNT; s++) {
     size_t n = 20000;
-    double *xyz = sample((sc_surface_t)s, SC_DENSITY_UNIFORM_RANDOM, n, 8);
-    double unit = sc_surface_spacing((sc_surface_t)s, n);
+    double *xyz = sample((scs_surface_t)s, SCS_DENSITY_UNIFORM_RANDOM, n, 8);
+    double unit = scs_surface_spacing((scs_surface_t)s, n);
     double *nn = nearest(xyz, n, unit);
     stats_t st = stats_of(nn, n, unit);
-    TS_NEAR(st.median, median, 0.012);
-    TS_LT(st.min, 0.1);
+    EXPECT_NEAR(st.median, median, 0.012);
+    EXPECT_LT(st.min, 0.1);
     free(nn);
     free(xyz);
   }
@@ -199,8 +202,8 @@ static void test_random(void) {
  * the inner sphere, at half the spacing. */
 static void test_adaptive(void) {
   size_t n = 8000;
-  double *xyz = sample(SC_SURF_NESTED_SPHERES, SC_DENSITY_ADAPTIVE, n, 9);
-  double *nn = nearest(xyz, n, sc_surface_spacing(SC_SURF_NESTED_SPHERES, n));
+  double *xyz = sample(SCS_SURF_NESTED_SPHERES, SCS_DENSITY_ADAPTIVE, n, 9);
+  double *nn = nearest(xyz, n, scs_surface_spacing(SCS_SURF_NESTED_SPHERES, n));
   double *in = malloc(n * sizeof *in), *out = malloc(n * sizeof *out);
   if (!in || !out)
     abort();
@@ -212,13 +215,13 @@ static void test_adaptive(void) {
     else
       out[n_out++] = nn[i];
   }
-  TS_NEAR((double)n_in / (double)n, 0.5, 0.02);
+  EXPECT_NEAR((double)n_in / (double)n, 0.5, 0.02);
   stats_t si = stats_of(in, n_in, 1), so = stats_of(out, n_out, 1);
-  TS_NEAR(so.median / si.median, 2.0, 0.15);
+  EXPECT_NEAR(so.median / si.median, 2.0, 0.15);
   /* Each sphere on its own is well spaced at its own density. */
   double unit_in = sqrt(3.14159265358979323846 * 0.25 * 4 / (double)n_in);
-  TS_TRUE(si.min / unit_in >= 0.55, "inner sphere: min %.3f units",
-          si.min / unit_in);
+  EXPECT_MSG(si.min / unit_in >= 0.55, "inner sphere: min %.3f units",
+             si.min / unit_in);
   free(in);
   free(out);
   free(nn);
@@ -227,8 +230,8 @@ static void test_adaptive(void) {
   /* The ellipsoid: closer points at the curved tips of its long axis than
    * at its flat poles, by up to sqrt(6) (measured 2.12). */
   n = 6000;
-  xyz = sample(SC_SURF_ELLIPSOID, SC_DENSITY_ADAPTIVE, n, 5);
-  nn = nearest(xyz, n, sc_surface_spacing(SC_SURF_ELLIPSOID, n));
+  xyz = sample(SCS_SURF_ELLIPSOID, SCS_DENSITY_ADAPTIVE, n, 5);
+  nn = nearest(xyz, n, scs_surface_spacing(SCS_SURF_ELLIPSOID, n));
   double *tip = malloc(n * sizeof *tip), *flat = malloc(n * sizeof *flat);
   if (!tip || !flat)
     abort();
@@ -239,11 +242,11 @@ static void test_adaptive(void) {
     if (fabs(xyz[3 * i + 2]) > 0.29)
       flat[n_flat++] = nn[i];
   }
-  TS_TRUE(n_tip > 100 && n_flat > 100, "%zu tip and %zu flat points", n_tip,
-          n_flat);
+  EXPECT_MSG(n_tip > 100 && n_flat > 100, "%zu tip and %zu flat points", n_tip,
+             n_flat);
   double ratio =
       stats_of(flat, n_flat, 1).median / stats_of(tip, n_tip, 1).median;
-  TS_TRUE(ratio > 1.8 && ratio < 2.6, "flat / tip spacing %.3f", ratio);
+  EXPECT_MSG(ratio > 1.8 && ratio < 2.6, "flat / tip spacing %.3f", ratio);
   free(tip);
   free(flat);
   free(nn);
@@ -253,7 +256,7 @@ static void test_adaptive(void) {
 /* The grid search against brute force, on a sample with clumps. */
 static void test_nearest(void) {
   size_t n = 700;
-  double *xyz = sample(SC_SURF_GENUS2, SC_DENSITY_UNIFORM_RANDOM, n, 10);
+  double *xyz = sample(SCS_SURF_GENUS2, SCS_DENSITY_UNIFORM_RANDOM, n, 10);
   /* A far outlier, so that rings must grow well past the first. */
   xyz[0] = 5;
   double *nn = nearest(xyz, n, 0.05);
@@ -268,7 +271,7 @@ static void test_nearest(void) {
               (xyz[3 * i + k] - xyz[3 * j + k]);
       best = d2 < best ? d2 : best;
     }
-    TS_NEAR(nn[i], sqrt(best), 0);
+    EXPECT_NEAR(nn[i], sqrt(best), 0);
   }
   free(nn);
   free(xyz);
@@ -279,5 +282,5 @@ int main(void) {
   test_uniform();
   test_random();
   test_adaptive();
-  return ts_exit_code();
+  return sct_finish("synth_spacing");
 }

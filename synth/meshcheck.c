@@ -44,7 +44,7 @@ static void uf_union(uint32_t *parent, uint32_t a, uint32_t b) {
     parent[a] = b;
 }
 
-void sc_meshcheck_free(sc_meshcheck_t *c) {
+void scs_meshcheck_free(scs_meshcheck_t *c) {
   if (!c)
     return;
   free(c->comp);
@@ -88,21 +88,21 @@ static void work_free(work_t *w) {
 /* Corner k of measured triangle t, as a vertex index. */
 #define CORNER(tri, live, t, k) ((tri)[3 * (size_t)(live)[t] + (k)])
 
-int sc_meshcheck(size_t n, const double *xyz, const uint32_t *tri,
-                 size_t ntri, const unsigned char *ignore,
-                 sc_meshcheck_t *out) {
+int scs_meshcheck(size_t n, const double *xyz, const uint32_t *tri,
+                  size_t ntri, const unsigned char *ignore,
+                  scs_meshcheck_t *out) {
   if (!out)
-    return SC_TS_EINVAL;
+    return SCS_EINVAL;
   memset(out, 0, sizeof *out);
   if ((ntri && !tri) || n > UINT32_MAX || ntri > UINT32_MAX / 3)
-    return SC_TS_EINVAL;
+    return SCS_EINVAL;
   out->points = n;
   out->triangles = ntri;
 
   work_t w;
   memset(&w, 0, sizeof w);
-  int rc = SC_TS_ENOMEM;
-  int vbits = ts_bits(n ? n - 1 : 0);
+  int rc = SCS_ENOMEM;
+  int vbits = scs_bits(n ? n - 1 : 0);
   if (vbits == 0)
     vbits = 1;
 
@@ -148,12 +148,12 @@ int sc_meshcheck(size_t n, const double *xyz, const uint32_t *tri,
     }
     for (size_t t = 0; t < nlive; t++)
       w.keys[t] = (uint64_t)sorted[3 * t + 1] << vbits | sorted[3 * t + 2];
-    if ((rc = ts_radix_sort(w.keys, w.vals, nlive, 2 * vbits, w.tmpk,
-                            w.tmpv)))
+    if ((rc = scs_radix_sort(w.keys, w.vals, nlive, 2 * vbits, w.tmpk,
+                             w.tmpv)))
       goto fail;
     for (size_t t = 0; t < nlive; t++)
       w.keys[t] = sorted[3 * (size_t)w.vals[t]];
-    if ((rc = ts_radix_sort(w.keys, w.vals, nlive, vbits, w.tmpk, w.tmpv)))
+    if ((rc = scs_radix_sort(w.keys, w.vals, nlive, vbits, w.tmpk, w.tmpv)))
       goto fail;
     /* Within a run of equal triples keep the earliest (smallest index). */
     for (size_t i = 0; i < nlive;) {
@@ -181,7 +181,7 @@ int sc_meshcheck(size_t n, const double *xyz, const uint32_t *tri,
     free(w.drop);
     w.sorted = NULL;
     w.drop = NULL;
-    rc = SC_TS_ENOMEM;
+    rc = SCS_ENOMEM;
   }
   out->faces = nlive;
 
@@ -210,9 +210,9 @@ int sc_meshcheck(size_t n, const double *xyz, const uint32_t *tri,
       w.keys[3 * t + k] = lo << vbits | hi;
       w.vals[3 * t + k] = (uint32_t)(3 * t + k);
     }
-  if ((rc = ts_radix_sort(w.keys, w.vals, ne, 2 * vbits, w.tmpk, w.tmpv)))
+  if ((rc = scs_radix_sort(w.keys, w.vals, ne, 2 * vbits, w.tmpk, w.tmpv)))
     goto fail;
-  rc = SC_TS_ENOMEM;
+  rc = SCS_ENOMEM;
 
   w.tri_parent = malloc((nlive ? nlive : 1) * sizeof *w.tri_parent);
   w.corner_parent = malloc((ne ? ne : 1) * sizeof *w.corner_parent);
@@ -293,7 +293,7 @@ int sc_meshcheck(size_t n, const double *xyz, const uint32_t *tri,
     size_t j = i + 1;
     while (j < ne && w.keys[j] == w.keys[i])
       j++;
-    sc_meshcheck_component_t *cp = &out->comp[w.comp_of[w.vals[i] / 3]];
+    scs_meshcheck_component_t *cp = &out->comp[w.comp_of[w.vals[i] / 3]];
     cp->edges++;
     if (j - i == 1)
       cp->boundary_edges++;
@@ -406,7 +406,7 @@ int sc_meshcheck(size_t n, const double *xyz, const uint32_t *tri,
   }
 
   for (size_t i = 0; i < ncomp; i++) {
-    sc_meshcheck_component_t *cp = &out->comp[i];
+    scs_meshcheck_component_t *cp = &out->comp[i];
     cp->closed = cp->boundary_edges == 0;
     cp->euler = (int64_t)cp->vertices - (int64_t)cp->edges +
                 (int64_t)cp->triangles;
@@ -425,16 +425,16 @@ int sc_meshcheck(size_t n, const double *xyz, const uint32_t *tri,
   out->closed = out->manifold && out->boundary_edges == 0;
   out->oriented = out->orientation_errors == 0;
   work_free(&w);
-  return SC_TS_OK;
+  return SCS_OK;
 
 fail:
   work_free(&w);
-  sc_meshcheck_free(out);
+  scs_meshcheck_free(out);
   memset(out, 0, sizeof *out);
   return rc;
 }
 
-char *sc_meshcheck_summary(const sc_meshcheck_t *c, char *buf, size_t len) {
+char *scs_meshcheck_summary(const scs_meshcheck_t *c, char *buf, size_t len) {
   if (!buf || len == 0)
     return buf;
   buf[0] = '\0';
@@ -473,15 +473,15 @@ static int cmp_int(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-int sc_meshcheck_expect(const sc_meshcheck_t *c, sc_surface_t s,
-                        unsigned flags, char *why, size_t why_len) {
+int scs_meshcheck_expect(const scs_meshcheck_t *c, scs_surface_t s,
+                         unsigned flags, char *why, size_t why_len) {
   char scratch[8];
   if (!why || why_len == 0) {
     why = scratch;
     why_len = sizeof scratch;
   }
   why[0] = '\0';
-  const sc_surface_info_t *info = sc_surface_info(s);
+  const scs_surface_info_t *info = scs_surface_info(s);
   if (!c || !info) {
     snprintf(why, why_len, "invalid argument");
     return 0;
@@ -510,7 +510,7 @@ int sc_meshcheck_expect(const sc_meshcheck_t *c, sc_surface_t s,
   if (c->components != (uint64_t)info->components)
     FAIL("%" PRIu64 " components, expected %d", c->components,
          info->components);
-  int want[SC_SURF_MAX_COMPONENTS], got[SC_SURF_MAX_COMPONENTS];
+  int want[SCS_SURF_MAX_COMPONENTS], got[SCS_SURF_MAX_COMPONENTS];
   for (int i = 0; i < info->components; i++) {
     want[i] = info->genus[i];
     got[i] = (int)c->comp[i].genus;
@@ -521,9 +521,9 @@ int sc_meshcheck_expect(const sc_meshcheck_t *c, sc_surface_t s,
     if (want[i] != got[i])
       FAIL("genus %d where %d was expected (sorted position %d)", got[i],
            want[i], i);
-  if ((flags & SC_EXPECT_ALL_USED) && c->samples_unused)
+  if ((flags & SCS_EXPECT_ALL_USED) && c->samples_unused)
     FAIL("%" PRIu64 " samples unused", c->samples_unused);
-  if (flags & SC_EXPECT_OUTWARD)
+  if (flags & SCS_EXPECT_OUTWARD)
     for (size_t i = 0; i < c->component_count; i++)
       if (!(c->comp[i].volume > 0))
         FAIL("component %zu has signed volume %g, not positive", i,
@@ -532,24 +532,24 @@ int sc_meshcheck_expect(const sc_meshcheck_t *c, sc_surface_t s,
   return 1;
 }
 
-int sc_mesh_distance_check(sc_surface_t s, size_t n, const double *xyz,
-                           const uint32_t *tri, size_t ntri, double tol,
-                           sc_distcheck_t *out) {
+int scs_mesh_distance_check(scs_surface_t s, size_t n, const double *xyz,
+                            const uint32_t *tri, size_t ntri, double tol,
+                            scs_distcheck_t *out) {
   if (!out)
-    return SC_TS_EINVAL;
+    return SCS_EINVAL;
   memset(out, 0, sizeof *out);
-  if (!sc_surface_info(s) || (n && !xyz) || (ntri && !tri))
-    return SC_TS_EINVAL;
+  if (!scs_surface_info(s) || (n && !xyz) || (ntri && !tri))
+    return SCS_EINVAL;
   unsigned char *seen = calloc(n ? n : 1, 1);
   if (!seen)
-    return SC_TS_ENOMEM;
+    return SCS_ENOMEM;
   for (size_t i = 0; i < 3 * ntri; i++) {
     uint32_t v = tri[i];
     if (v >= n || seen[v])
       continue;
     seen[v] = 1;
     out->vertices++;
-    double d = sc_surface_distance(s, xyz + 3 * (size_t)v);
+    double d = scs_surface_distance(s, xyz + 3 * (size_t)v);
     /* A non-finite coordinate is as far off as it gets. */
     if (d != d)
       d = HUGE_VAL;
@@ -561,5 +561,5 @@ int sc_mesh_distance_check(sc_surface_t s, size_t n, const double *xyz,
     }
   }
   free(seen);
-  return SC_TS_OK;
+  return SCS_OK;
 }

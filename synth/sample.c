@@ -33,19 +33,19 @@ static double oversampling(size_t n) {
   return k < 2 ? 2 : k;
 }
 
-static const char *density_names[SC_DENSITY_COUNT] = {"uniform-random",
-                                                      "uniform", "adaptive"};
+static const char *density_names[SCS_DENSITY_COUNT] = {"uniform-random",
+                                                       "uniform", "adaptive"};
 
-const char *sc_density_name(int density) {
-  if (density < 0 || density >= SC_DENSITY_COUNT)
+const char *scs_density_name(int density) {
+  if (density < 0 || density >= SCS_DENSITY_COUNT)
     return "?";
   return density_names[density];
 }
 
-int sc_density_from_name(const char *name) {
+int scs_density_from_name(const char *name) {
   if (!name)
     return -1;
-  for (int d = 0; d < SC_DENSITY_COUNT; d++)
+  for (int d = 0; d < SCS_DENSITY_COUNT; d++)
     if (strcmp(name, density_names[d]) == 0)
       return d;
   return -1;
@@ -228,7 +228,7 @@ static int elim_build(elim_t *el, const double *cand, const double *radius,
   el->grid.inv_h = 1 / h;
   memcpy(el->grid.origin, lo, sizeof lo);
 
-  int rc = SC_TS_ENOMEM;
+  int rc = SCS_ENOMEM;
   uint64_t *keys = malloc(m * sizeof *keys);
   uint64_t *tmpk = malloc(m * sizeof *tmpk);
   uint32_t *tmpv = malloc(m * sizeof *tmpv);
@@ -243,7 +243,7 @@ static int elim_build(elim_t *el, const double *cand, const double *radius,
     keys[j] = cell_key(c[0], c[1], c[2]);
     el->order[j] = (uint32_t)j;
   }
-  if ((rc = ts_radix_sort(keys, el->order, m, 3 * CELL_BITS, tmpk, tmpv)))
+  if ((rc = scs_radix_sort(keys, el->order, m, 3 * CELL_BITS, tmpk, tmpv)))
     goto out;
   size_t cells = 0;
   for (size_t j = 0; j < m; j++) {
@@ -256,7 +256,7 @@ static int elim_build(elim_t *el, const double *cand, const double *radius,
   size_t size = 16;
   while (size < 2 * cells)
     size *= 2;
-  rc = SC_TS_ENOMEM;
+  rc = SCS_ENOMEM;
   el->grid.mask = size - 1;
   el->grid.keys = malloc(size * sizeof *el->grid.keys);
   el->grid.start = malloc(size * sizeof *el->grid.start);
@@ -277,7 +277,7 @@ static int elim_build(elim_t *el, const double *cand, const double *radius,
     el->grid.end[slot] = (uint32_t)e;
     j = e;
   }
-  rc = SC_TS_OK;
+  rc = SCS_OK;
 out:
   free(keys);
   free(tmpk);
@@ -300,7 +300,7 @@ static int eliminate(const double *cand, const double *radius, size_t m,
   int rc = elim_build(&el, cand, radius, m);
   if (rc)
     goto out;
-  rc = SC_TS_ENOMEM;
+  rc = SCS_ENOMEM;
   el.w = calloc(m, sizeof *el.w);
   el.heap = malloc(m * sizeof *el.heap);
   el.where = malloc(m * sizeof *el.where);
@@ -355,46 +355,46 @@ static int eliminate(const double *cand, const double *radius, size_t m,
   memset(keep, 0, m);
   for (size_t i = 0; i < el.heap_n; i++)
     keep[el.order[el.heap[i]]] = 1;
-  rc = SC_TS_OK;
+  rc = SCS_OK;
 out:
   elim_free(&el);
   return rc;
 }
 
 /* Area density of ADAPTIVE, relative to its maximum: in [1/6, 1]. */
-static double adaptive_density(sc_surface_t s, const double p[3],
+static double adaptive_density(scs_surface_t s, const double p[3],
                                double ktop) {
-  double k = ts_surface_kmax(s, p) / ktop;
+  double k = scs_surface_kmax(s, p) / ktop;
   double rho = k * k;
   return rho > 1 ? 1 : rho < 1.0 / 6 ? 1.0 / 6 : rho;
 }
 
-int sc_sample_surface(sc_surface_t s, int density, size_t n, uint64_t seed,
-                      double *xyz) {
-  const sc_surface_info_t *info = sc_surface_info(s);
-  if (!info || density < 0 || density >= SC_DENSITY_COUNT || (n && !xyz))
-    return SC_TS_EINVAL;
+int scs_sample_surface(scs_surface_t s, int density, size_t n, uint64_t seed,
+                       double *xyz) {
+  const scs_surface_info_t *info = scs_surface_info(s);
+  if (!info || density < 0 || density >= SCS_DENSITY_COUNT || (n && !xyz))
+    return SCS_EINVAL;
   if (n == 0)
-    return SC_TS_OK;
-  sc_rng_t rng;
-  sc_rng_seed(&rng, seed);
-  if (density == SC_DENSITY_UNIFORM_RANDOM) {
+    return SCS_OK;
+  scs_rng_t rng;
+  scs_rng_seed(&rng, seed);
+  if (density == SCS_DENSITY_UNIFORM_RANDOM) {
     for (size_t i = 0; i < n; i++)
-      ts_surface_point(s, &rng, xyz + 3 * i);
-    return SC_TS_OK;
+      scs_surface_point(s, &rng, xyz + 3 * i);
+    return SCS_OK;
   }
   if (n > MAX_SPACED_POINTS)
-    return SC_TS_EINVAL;
+    return SCS_EINVAL;
 
   size_t m = (size_t)ceil(oversampling(n) * (double)n);
   /* Always true (the factor is at least 2); stated so that the compiler,
    * too, knows the candidate arrays below are filled before use. */
   if (m <= n)
-    return SC_TS_EINVAL;
+    return SCS_EINVAL;
   double *cand = malloc(3 * m * sizeof *cand);
   double *radius = malloc(m * sizeof *radius);
   unsigned char *keep = malloc(m);
-  int rc = SC_TS_ENOMEM;
+  int rc = SCS_ENOMEM;
   if (!cand || !radius || !keep)
     goto out;
 
@@ -406,9 +406,9 @@ int sc_sample_surface(sc_surface_t s, int density, size_t n, uint64_t seed,
    * proposals are area-uniform: Z = A * (accepted / proposed).
    */
   const double two_sqrt3 = 3.4641016151377546;
-  if (density == SC_DENSITY_UNIFORM) {
+  if (density == SCS_DENSITY_UNIFORM) {
     for (size_t j = 0; j < m; j++)
-      ts_surface_point(s, &rng, cand + 3 * j);
+      scs_surface_point(s, &rng, cand + 3 * j);
     double r = sqrt(info->area / (two_sqrt3 * (double)n));
     for (size_t j = 0; j < m; j++)
       radius[j] = r;
@@ -416,10 +416,10 @@ int sc_sample_surface(sc_surface_t s, int density, size_t n, uint64_t seed,
     uint64_t proposed = 0;
     for (size_t j = 0; j < m;) {
       double *p = cand + 3 * j;
-      ts_surface_point(s, &rng, p);
+      scs_surface_point(s, &rng, p);
       proposed++;
       double rho = adaptive_density(s, p, info->max_curvature);
-      if (sc_rng_uniform(&rng) < rho) {
+      if (scs_rng_uniform(&rng) < rho) {
         radius[j] = rho;
         j++;
       }
@@ -436,7 +436,7 @@ int sc_sample_surface(sc_surface_t s, int density, size_t n, uint64_t seed,
       memcpy(xyz + 3 * out_n, cand + 3 * j, 3 * sizeof *xyz);
       out_n++;
     }
-  rc = out_n == n ? SC_TS_OK : SC_TS_EINVAL;
+  rc = out_n == n ? SCS_OK : SCS_EINVAL;
 out:
   free(cand);
   free(radius);

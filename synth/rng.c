@@ -5,9 +5,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "testsupport.h"
-
-#include <time.h>
+#include "synth.h"
 
 static uint64_t splitmix64(uint64_t *x) {
   uint64_t z = (*x += 0x9e3779b97f4a7c15ull);
@@ -18,13 +16,13 @@ static uint64_t splitmix64(uint64_t *x) {
 
 static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
 
-void sc_rng_seed(sc_rng_t *rng, uint64_t seed) {
+void scs_rng_seed(scs_rng_t *rng, uint64_t seed) {
   uint64_t x = seed;
   for (int i = 0; i < 4; i++)
     rng->s[i] = splitmix64(&x);
 }
 
-uint64_t sc_rng_next(sc_rng_t *rng) {
+uint64_t scs_rng_next(scs_rng_t *rng) {
   uint64_t *s = rng->s;
   uint64_t result = rotl(s[1] * 5, 7) * 9;
   uint64_t t = s[1] << 17;
@@ -37,12 +35,6 @@ uint64_t sc_rng_next(sc_rng_t *rng) {
   return result;
 }
 
-double sc_rng_uniform(sc_rng_t *rng) {
-  return (double)(sc_rng_next(rng) >> 11) * 0x1.0p-53;
-}
-
-double sc_ts_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+double scs_rng_uniform(scs_rng_t *rng) {
+  return (double)(scs_rng_next(rng) >> 11) * 0x1.0p-53;
 }

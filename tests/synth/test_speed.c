@@ -7,27 +7,30 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include "sct_assert.h"
+#include "synth.h"
 #include "testsupport.h"
-#include "tsassert.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
-static void time_sampling(sc_surface_t s, int d, size_t n) {
+static void time_sampling(scs_surface_t s, int d, size_t n) {
   double *xyz = malloc(3 * n * sizeof *xyz);
   if (!xyz)
     abort();
-  double t0 = sc_ts_seconds();
-  int rc = sc_sample_surface(s, d, n, 1, xyz);
-  double t1 = sc_ts_seconds();
-  TS_EQ_I64(rc, SC_TS_OK);
+  double t0 = sct_seconds();
+  int rc = scs_sample_surface(s, d, n, 1, xyz);
+  double t1 = sct_seconds();
+  EXPECT_EQ(rc, SCS_OK);
   double worst = 0;
   for (size_t i = 0; i < n; i++) {
-    double dist = sc_surface_distance(s, xyz + 3 * i);
+    double dist = scs_surface_distance(s, xyz + 3 * i);
     worst = dist > worst || dist != dist ? dist : worst;
   }
-  TS_LE(worst, 1e-9);
-  printf("sample %s/%s, %zu points: %.3f s\n", sc_surface_name(s),
-         sc_density_name(d), n, t1 - t0);
+  EXPECT_LE(worst, 1e-9);
+  printf("sample %s/%s, %zu points: %.3f s\n", scs_surface_name(s),
+         scs_density_name(d), n, t1 - t0);
   free(xyz);
 }
 
@@ -57,39 +60,39 @@ static void time_meshcheck(void) {
       for (int k = 0; k < 6; k++)
         *t++ = q[k];
     }
-  sc_meshcheck_t c;
-  double t0 = sc_ts_seconds();
-  int rc = sc_meshcheck(n, xyz, tri, ntri, NULL, &c);
-  double t1 = sc_ts_seconds();
-  TS_EQ_I64(rc, SC_TS_OK);
-  TS_EQ_U64(c.faces, ntri);
-  TS_EQ_U64(c.edges, 3 * n);
-  TS_EQ_U64(c.vertices_used, n);
-  TS_EQ_U64(c.components, 1);
-  TS_EQ_I64(c.genus_total, 1);
-  TS_TRUE(c.closed && c.oriented, "closed %d oriented %d", c.closed,
-          c.oriented);
+  scs_meshcheck_t c;
+  double t0 = sct_seconds();
+  int rc = scs_meshcheck(n, xyz, tri, ntri, NULL, &c);
+  double t1 = sct_seconds();
+  EXPECT_EQ(rc, SCS_OK);
+  EXPECT_EQ(c.faces, ntri);
+  EXPECT_EQ(c.edges, 3 * n);
+  EXPECT_EQ(c.vertices_used, n);
+  EXPECT_EQ(c.components, 1);
+  EXPECT_EQ(c.genus_total, 1);
+  EXPECT_MSG(c.closed && c.oriented, "closed %d oriented %d", c.closed,
+             c.oriented);
   char why[256];
-  TS_TRUE(sc_meshcheck_expect(&c, SC_SURF_TORUS,
-                              SC_EXPECT_ALL_USED | SC_EXPECT_OUTWARD, why,
-                              sizeof why),
-          "%s", why);
+  EXPECT_MSG(scs_meshcheck_expect(&c, SCS_SURF_TORUS,
+                                  SCS_EXPECT_ALL_USED | SCS_EXPECT_OUTWARD, why,
+                                  sizeof why),
+             "%s", why);
   /* The inscribed polyhedron falls short of the torus by O(h^2). */
-  const sc_surface_info_t *info = sc_surface_info(SC_SURF_TORUS);
-  TS_NEAR(c.volume / info->volume[0], 1, 1e-4);
-  TS_NEAR(c.area / info->area, 1, 1e-4);
+  const scs_surface_info_t *info = scs_surface_info(SCS_SURF_TORUS);
+  EXPECT_NEAR(c.volume / info->volume[0], 1, 1e-4);
+  EXPECT_NEAR(c.area / info->area, 1, 1e-4);
   char line[512];
   printf("meshcheck, %zu triangles: %.3f s\n  %s\n", ntri, t1 - t0,
-         sc_meshcheck_summary(&c, line, sizeof line));
-  sc_meshcheck_free(&c);
+         scs_meshcheck_summary(&c, line, sizeof line));
+  scs_meshcheck_free(&c);
   free(xyz);
   free(tri);
 }
 
 int main(void) {
-  time_sampling(SC_SURF_SPHERE, SC_DENSITY_UNIFORM_RANDOM, 1000000);
-  time_sampling(SC_SURF_SPHERE, SC_DENSITY_UNIFORM, 1000000);
-  time_sampling(SC_SURF_TORUS, SC_DENSITY_ADAPTIVE, 1000000);
+  time_sampling(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM_RANDOM, 1000000);
+  time_sampling(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM, 1000000);
+  time_sampling(SCS_SURF_TORUS, SCS_DENSITY_ADAPTIVE, 1000000);
   time_meshcheck();
-  return ts_exit_code();
+  return sct_finish("synth_speed");
 }

@@ -64,53 +64,53 @@
 /* The ellipsoid's area by Legendre's formula with elliptic integrals. */
 #define E_AREA 4.8344354495500
 
-static const sc_surface_info_t infos[SC_SURF_COUNT] = {
-    [SC_SURF_SPHERE] = {"sphere", 1, {0, 0}, 0, 4 * PI, {4 * PI / 3, 0},
-                        {-1, -1, -1}, {1, 1, 1}, 1.0},
-    [SC_SURF_ELLIPSOID] = {"ellipsoid", 1, {0, 0}, 0, E_AREA,
-                           {4 * PI / 3 * EA * EB * EC, 0},
-                           {-EA, -EB, -EC}, {EA, EB, EC}, EA / (EC * EC)},
-    [SC_SURF_TORUS] = {"torus", 1, {1, 0}, 1, 4 * PI * PI * TOR_R * TOR_RR,
-                       {2 * PI * PI * TOR_R * TOR_RR * TOR_RR, 0},
-                       {-(TOR_R + TOR_RR), -(TOR_R + TOR_RR), -TOR_RR},
-                       {TOR_R + TOR_RR, TOR_R + TOR_RR, TOR_RR},
-                       1.0 / TOR_RR},
-    [SC_SURF_GENUS2] = {"genus2", 1, {2, 0}, 2, G2_AREA, {G2_VOLUME, 0},
-                        {-G2_SCALE * G2_X, -G2_SCALE * G2_Y, -G2_SCALE * G2_Z},
-                        {G2_SCALE * G2_X, G2_SCALE * G2_Y, G2_SCALE * G2_Z},
-                        G2_KMAX},
-    [SC_SURF_TWO_SPHERES] = {"two-spheres", 2, {0, 0}, 0, 8 * PI,
-                             {4 * PI / 3, 4 * PI / 3},
-                             {-TWO_X - 1, -1, -1}, {TWO_X + 1, 1, 1}, 1.0},
-    [SC_SURF_NESTED_SPHERES] = {"nested-spheres", 2, {0, 0}, 0,
-                                4 * PI * (1 + NEST_IN * NEST_IN),
-                                {4 * PI / 3,
-                                 4 * PI / 3 * NEST_IN * NEST_IN * NEST_IN},
+static const scs_surface_info_t infos[SCS_SURF_COUNT] = {
+    [SCS_SURF_SPHERE] = {"sphere", 1, {0, 0}, 0, 4 * PI, {4 * PI / 3, 0},
+                         {-1, -1, -1}, {1, 1, 1}, 1.0},
+    [SCS_SURF_ELLIPSOID] = {"ellipsoid", 1, {0, 0}, 0, E_AREA,
+                            {4 * PI / 3 * EA * EB * EC, 0},
+                            {-EA, -EB, -EC}, {EA, EB, EC}, EA / (EC * EC)},
+    [SCS_SURF_TORUS] = {"torus", 1, {1, 0}, 1, 4 * PI * PI * TOR_R * TOR_RR,
+                        {2 * PI * PI * TOR_R * TOR_RR * TOR_RR, 0},
+                        {-(TOR_R + TOR_RR), -(TOR_R + TOR_RR), -TOR_RR},
+                        {TOR_R + TOR_RR, TOR_R + TOR_RR, TOR_RR},
+                        1.0 / TOR_RR},
+    [SCS_SURF_GENUS2] = {"genus2", 1, {2, 0}, 2, G2_AREA, {G2_VOLUME, 0},
+                         {-G2_SCALE * G2_X, -G2_SCALE * G2_Y, -G2_SCALE * G2_Z},
+                         {G2_SCALE * G2_X, G2_SCALE * G2_Y, G2_SCALE * G2_Z},
+                         G2_KMAX},
+    [SCS_SURF_TWO_SPHERES] = {"two-spheres", 2, {0, 0}, 0, 8 * PI,
+                              {4 * PI / 3, 4 * PI / 3},
+                              {-TWO_X - 1, -1, -1}, {TWO_X + 1, 1, 1}, 1.0},
+    [SCS_SURF_NESTED_SPHERES] = {"nested-spheres", 2, {0, 0}, 0,
+                                 4 * PI * (1 + NEST_IN * NEST_IN),
+                                 {4 * PI / 3,
+                                  4 * PI / 3 * NEST_IN * NEST_IN * NEST_IN},
                                 {-1, -1, -1}, {1, 1, 1}, 1.0 / NEST_IN},
 };
 
-const sc_surface_info_t *sc_surface_info(sc_surface_t s) {
-  if ((int)s < 0 || s >= SC_SURF_COUNT)
+const scs_surface_info_t *scs_surface_info(scs_surface_t s) {
+  if ((int)s < 0 || s >= SCS_SURF_COUNT)
     return NULL;
   return &infos[s];
 }
 
-const char *sc_surface_name(sc_surface_t s) {
-  const sc_surface_info_t *info = sc_surface_info(s);
+const char *scs_surface_name(scs_surface_t s) {
+  const scs_surface_info_t *info = scs_surface_info(s);
   return info ? info->name : "?";
 }
 
-int sc_surface_from_name(const char *name) {
+int scs_surface_from_name(const char *name) {
   if (!name)
     return -1;
-  for (int s = 0; s < SC_SURF_COUNT; s++)
+  for (int s = 0; s < SCS_SURF_COUNT; s++)
     if (strcmp(name, infos[s].name) == 0)
       return s;
   return -1;
 }
 
-double sc_surface_spacing(sc_surface_t s, size_t n) {
-  const sc_surface_info_t *info = sc_surface_info(s);
+double scs_surface_spacing(scs_surface_t s, size_t n) {
+  const scs_surface_info_t *info = scs_surface_info(s);
   if (!info || n == 0)
     return 0;
   return sqrt(info->area / (double)n);
@@ -127,10 +127,10 @@ static double norm3(const double a[3]) { return sqrt(dot3(a, a)); }
  * length 1. Points very near the centre are rejected too, which keeps the
  * division accurate and, being a ball itself, does not bias the direction.
  */
-static void random_direction(sc_rng_t *rng, double u[3]) {
+static void random_direction(scs_rng_t *rng, double u[3]) {
   for (;;) {
     for (int i = 0; i < 3; i++)
-      u[i] = 2 * sc_rng_uniform(rng) - 1;
+      u[i] = 2 * scs_rng_uniform(rng) - 1;
     double s = dot3(u, u);
     if (s <= 1 && s > 1e-6) {
       double inv = 1 / sqrt(s);
@@ -142,9 +142,9 @@ static void random_direction(sc_rng_t *rng, double u[3]) {
 }
 
 /* The two-dimensional version: (cos t, sin t) for uniform t, without trig. */
-static void random_circle(sc_rng_t *rng, double *c, double *s) {
+static void random_circle(scs_rng_t *rng, double *c, double *s) {
   for (;;) {
-    double a = 2 * sc_rng_uniform(rng) - 1, b = 2 * sc_rng_uniform(rng) - 1;
+    double a = 2 * scs_rng_uniform(rng) - 1, b = 2 * scs_rng_uniform(rng) - 1;
     double r2 = a * a + b * b;
     if (r2 <= 1 && r2 > 1e-6) {
       double inv = 1 / sqrt(r2);
@@ -160,14 +160,14 @@ static void random_circle(sc_rng_t *rng, double *c, double *s) {
  * stretches area by abc |(u1/a, u2/b, u3/c)|, so accepting with probability
  * proportional to that factor makes the result exactly area-uniform.
  */
-static void ellipsoid_point(sc_rng_t *rng, double p[3]) {
+static void ellipsoid_point(scs_rng_t *rng, double p[3]) {
   const double wmax = EA * EB; /* the largest of bc, ac, ab */
   for (;;) {
     double u[3];
     random_direction(rng, u);
     double w0 = EB * EC * u[0], w1 = EA * EC * u[1], w2 = EA * EB * u[2];
     double w = sqrt(w0 * w0 + w1 * w1 + w2 * w2);
-    if (sc_rng_uniform(rng) * wmax < w) {
+    if (scs_rng_uniform(rng) * wmax < w) {
       p[0] = EA * u[0];
       p[1] = EB * u[1];
       p[2] = EC * u[2];
@@ -177,13 +177,13 @@ static void ellipsoid_point(sc_rng_t *rng, double p[3]) {
 }
 
 /* Torus: uniform angles, accepted in proportion to the circle radius there. */
-static void torus_point(sc_rng_t *rng, double p[3]) {
+static void torus_point(scs_rng_t *rng, double p[3]) {
   for (;;) {
     double cu, su, cv, sv;
     random_circle(rng, &cu, &su);
     random_circle(rng, &cv, &sv);
     double rho = TOR_R + TOR_RR * cv;
-    if (sc_rng_uniform(rng) * (TOR_R + TOR_RR) < rho) {
+    if (scs_rng_uniform(rng) * (TOR_R + TOR_RR) < rho) {
       p[0] = rho * cu;
       p[1] = rho * su;
       p[2] = TOR_RR * sv;
@@ -297,7 +297,7 @@ static int g2_line(int axis, double u, double v, double out[8][3]) {
  * points are independent. Choosing the axis with probability proportional
  * to (rectangle area) * K_a makes the density the same everywhere.
  */
-static void g2_point(sc_rng_t *rng, double p[3]) {
+static void g2_point(scs_rng_t *rng, double p[3]) {
   static const int slots[3] = {8, 4, 2};
   const double half[3][2] = {{G2_Y, G2_Z}, {G2_X, G2_Z}, {G2_X, G2_Y}};
   double weight[3], total = 0;
@@ -307,14 +307,14 @@ static void g2_point(sc_rng_t *rng, double p[3]) {
   }
   const double sqrt3 = 1.7320508075688772;
   for (;;) {
-    double t = sc_rng_uniform(rng) * total;
+    double t = scs_rng_uniform(rng) * total;
     int axis = t < weight[0] ? 0 : t < weight[0] + weight[1] ? 1 : 2;
-    double u = (2 * sc_rng_uniform(rng) - 1) * half[axis][0];
-    double v = (2 * sc_rng_uniform(rng) - 1) * half[axis][1];
+    double u = (2 * scs_rng_uniform(rng) - 1) * half[axis][0];
+    double v = (2 * scs_rng_uniform(rng) - 1) * half[axis][1];
     double roots[8][3];
     int count = g2_line(axis, u, v, roots);
-    int j = (int)(sc_rng_uniform(rng) * slots[axis]);
-    double accept = sc_rng_uniform(rng);
+    int j = (int)(scs_rng_uniform(rng) * slots[axis]);
+    double accept = scs_rng_uniform(rng);
     if (j >= count)
       continue;
     double grad[3];
@@ -332,30 +332,30 @@ static void g2_point(sc_rng_t *rng, double p[3]) {
   }
 }
 
-void ts_surface_point(sc_surface_t s, sc_rng_t *rng, double p[3]) {
+void scs_surface_point(scs_surface_t s, scs_rng_t *rng, double p[3]) {
   switch (s) {
-  case SC_SURF_SPHERE:
+  case SCS_SURF_SPHERE:
     random_direction(rng, p);
     break;
-  case SC_SURF_ELLIPSOID:
+  case SCS_SURF_ELLIPSOID:
     ellipsoid_point(rng, p);
     break;
-  case SC_SURF_TORUS:
+  case SCS_SURF_TORUS:
     torus_point(rng, p);
     break;
-  case SC_SURF_GENUS2:
+  case SCS_SURF_GENUS2:
     g2_point(rng, p);
     break;
-  case SC_SURF_TWO_SPHERES: {
+  case SCS_SURF_TWO_SPHERES: {
     /* Equal areas: each sphere half the time. */
-    double side = sc_rng_uniform(rng) < 0.5 ? -TWO_X : TWO_X;
+    double side = scs_rng_uniform(rng) < 0.5 ? -TWO_X : TWO_X;
     random_direction(rng, p);
     p[0] += side;
     break;
   }
-  case SC_SURF_NESTED_SPHERES: {
+  case SCS_SURF_NESTED_SPHERES: {
     /* The outer sphere has area 1 / (1 + r^2) of the total. */
-    double radius = sc_rng_uniform(rng) * (1 + NEST_IN * NEST_IN) < 1
+    double radius = scs_rng_uniform(rng) * (1 + NEST_IN * NEST_IN) < 1
                         ? 1.0
                         : NEST_IN;
     random_direction(rng, p);
@@ -418,25 +418,25 @@ static void ellipsoid_eval(const double q[3], double *f, double grad[3],
         hess[i][j] = i == j ? 2 * inv2[i] : 0;
 }
 
-double ts_surface_kmax(sc_surface_t s, const double p[3]) {
+double scs_surface_kmax(scs_surface_t s, const double p[3]) {
   double grad[3], hess[3][3];
   switch (s) {
-  case SC_SURF_ELLIPSOID:
+  case SCS_SURF_ELLIPSOID:
     ellipsoid_eval(p, NULL, grad, hess);
     return implicit_kmax(grad, hess);
-  case SC_SURF_TORUS: {
+  case SCS_SURF_TORUS: {
     /* Principal curvatures 1/r around the tube and cos(v) / rho along it;
      * cos(v) = (rho - R) / r. */
     double rho = sqrt(p[0] * p[0] + p[1] * p[1]);
     double k2 = rho > 0 ? fabs((rho - TOR_R) / TOR_RR / rho) : 0;
     return k2 > 1 / TOR_RR ? k2 : 1 / TOR_RR;
   }
-  case SC_SURF_GENUS2: {
+  case SCS_SURF_GENUS2: {
     double q[3] = {p[0] / G2_SCALE, p[1] / G2_SCALE, p[2] / G2_SCALE};
     g2_eval(q, NULL, grad, hess);
     return implicit_kmax(grad, hess) / G2_SCALE;
   }
-  case SC_SURF_NESTED_SPHERES:
+  case SCS_SURF_NESTED_SPHERES:
     return norm3(p) < (1 + NEST_IN) / 2 ? 1 / NEST_IN : 1.0;
   default:
     return 1.0;
@@ -520,8 +520,8 @@ static void implicit_foot(implicit_fn fn, const double p[3],
 }
 
 /* The foot point on the ellipsoid or the genus-2 surface, in world units. */
-static void foot_point(sc_surface_t s, const double p[3], double q[3]) {
-  if (s == SC_SURF_ELLIPSOID) {
+static void foot_point(scs_surface_t s, const double p[3], double q[3]) {
+  if (s == SCS_SURF_ELLIPSOID) {
     /* Starting from the radial projection puts the first point on the
      * surface even from deep inside, where Newton steps would be long. */
     double f, start[3];
@@ -549,24 +549,24 @@ static double sphere_distance(const double p[3], double cx, double r) {
   return fabs(norm3(d) - r);
 }
 
-double sc_surface_distance(sc_surface_t s, const double p[3]) {
+double scs_surface_distance(scs_surface_t s, const double p[3]) {
   switch (s) {
-  case SC_SURF_SPHERE:
+  case SCS_SURF_SPHERE:
     return sphere_distance(p, 0, 1);
-  case SC_SURF_TORUS: {
+  case SCS_SURF_TORUS: {
     double rho = sqrt(p[0] * p[0] + p[1] * p[1]) - TOR_R;
     return fabs(sqrt(rho * rho + p[2] * p[2]) - TOR_RR);
   }
-  case SC_SURF_TWO_SPHERES: {
+  case SCS_SURF_TWO_SPHERES: {
     double a = sphere_distance(p, -TWO_X, 1), b = sphere_distance(p, TWO_X, 1);
     return a < b ? a : b;
   }
-  case SC_SURF_NESTED_SPHERES: {
+  case SCS_SURF_NESTED_SPHERES: {
     double a = sphere_distance(p, 0, 1), b = sphere_distance(p, 0, NEST_IN);
     return a < b ? a : b;
   }
-  case SC_SURF_ELLIPSOID:
-  case SC_SURF_GENUS2: {
+  case SCS_SURF_ELLIPSOID:
+  case SCS_SURF_GENUS2: {
     double q[3];
     foot_point(s, p, q);
     double d[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
@@ -580,35 +580,35 @@ double sc_surface_distance(sc_surface_t s, const double p[3]) {
 static int unit(double v[3]) {
   double l = norm3(v);
   if (!(l > 0) || !isfinite(l))
-    return SC_TS_EINVAL;
+    return SCS_EINVAL;
   for (int i = 0; i < 3; i++)
     v[i] /= l;
-  return SC_TS_OK;
+  return SCS_OK;
 }
 
-int sc_surface_normal(sc_surface_t s, const double p[3], double n[3]) {
-  if (!p || !n || !sc_surface_info(s))
-    return SC_TS_EINVAL;
+int scs_surface_normal(scs_surface_t s, const double p[3], double n[3]) {
+  if (!p || !n || !scs_surface_info(s))
+    return SCS_EINVAL;
   switch (s) {
-  case SC_SURF_SPHERE:
-  case SC_SURF_NESTED_SPHERES:
+  case SCS_SURF_SPHERE:
+  case SCS_SURF_NESTED_SPHERES:
     memcpy(n, p, 3 * sizeof *n);
     break;
-  case SC_SURF_TWO_SPHERES:
+  case SCS_SURF_TWO_SPHERES:
     memcpy(n, p, 3 * sizeof *n);
     n[0] -= p[0] < 0 ? -TWO_X : TWO_X;
     break;
-  case SC_SURF_TORUS: {
+  case SCS_SURF_TORUS: {
     double rho = sqrt(p[0] * p[0] + p[1] * p[1]);
     if (!(rho > 0))
-      return SC_TS_EINVAL;
+      return SCS_EINVAL;
     double k = (rho - TOR_R) / rho;
     n[0] = p[0] * k;
     n[1] = p[1] * k;
     n[2] = p[2];
     break;
   }
-  case SC_SURF_ELLIPSOID: {
+  case SCS_SURF_ELLIPSOID: {
     double q[3];
     foot_point(s, p, q);
     ellipsoid_eval(q, NULL, n, NULL);

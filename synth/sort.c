@@ -14,7 +14,7 @@
 #define DIGIT_BITS 11
 #define DIGIT_COUNT (1u << DIGIT_BITS)
 
-int ts_bits(uint64_t x) {
+int scs_bits(uint64_t x) {
   int b = 0;
   while (x) {
     b++;
@@ -23,13 +23,13 @@ int ts_bits(uint64_t x) {
   return b;
 }
 
-int ts_radix_sort(uint64_t *keys, uint32_t *vals, size_t n, int key_bits,
-                  uint64_t *tmp_keys, uint32_t *tmp_vals) {
+int scs_radix_sort(uint64_t *keys, uint32_t *vals, size_t n, int key_bits,
+                   uint64_t *tmp_keys, uint32_t *tmp_vals) {
   if (n < 2)
-    return SC_TS_OK;
+    return SCS_OK;
   size_t *count = malloc(DIGIT_COUNT * sizeof *count);
   if (!count)
-    return SC_TS_ENOMEM;
+    return SCS_ENOMEM;
   uint64_t *src_k = keys, *dst_k = tmp_keys;
   uint32_t *src_v = vals, *dst_v = tmp_vals;
   for (int shift = 0; shift < key_bits; shift += DIGIT_BITS) {
@@ -62,5 +62,5 @@ int ts_radix_sort(uint64_t *keys, uint32_t *vals, size_t n, int key_bits,
     memcpy(vals, src_v, n * sizeof *vals);
   }
   free(count);
-  return SC_TS_OK;
+  return SCS_OK;
 }
