@@ -2,7 +2,7 @@
  * Test support for shortcrust: what only the tests need. The assertions are
  * in sct_assert.h; the surface samples and the mesh checker the tests share
  * with the benchmarks and the load generator are the synth module
- * (synth/synth.h). Every name here starts with sct_.
+ * (clients/synth/synth.h). Every name here starts with sct_.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
