@@ -229,12 +229,9 @@ size_t scp_format_size(uint32_t format);
 /* Feature bits (PROTOCOL.md 5). JOB_OPTIONS: JOB_BEGIN may carry job
  * options after its fixed part. */
 #define SCP_FEATURE_JOB_OPTIONS 0x1u
-/* The job options a server knows (PROTOCOL.md 6.3), by name and kind. */
-#define SCP_OPT_MAX_HOLE_EDGES "max_hole_edges"       /* u64, 0 to 100000 */
-#define SCP_OPT_BOUNDARY_RHO "boundary_rho"           /* f64, (0, 10] */
-#define SCP_OPT_BOUNDARY_ALPHA "boundary_alpha"       /* f64, (0, pi/2] */
-#define SCP_OPT_PAPER_PRUNING "paper_pruning"         /* u64, 0 or 1 */
-#define SCP_OPT_WATERTIGHT_LABELS "watertight_labels" /* u64, 0 or 1 */
+/* Job options (PROTOCOL.md 6.3) are named by the reconstruction's
+ * parameter table (SC_PARAM_MAP in core/shortcrust.h), which this module
+ * does not see: it carries them as a value list. */
 
 /* JOB_BEGIN flags. */
 #define SCP_JOB_NORMALS 0x1u

@@ -69,13 +69,13 @@ static void features(void) {
 static void options_apply(void) {
   scdt_conn_t *c = open_conn(SCP_FEATURE_JOB_OPTIONS);
   const scp_value_t opts[] = {
-      {.name = SCP_OPT_BOUNDARY_RHO, .kind = SCP_KIND_F64, .v.f = 0.05},
-      {.name = SCP_OPT_MAX_HOLE_EDGES, .kind = SCP_KIND_U64, .v.u = 0},
-      {.name = SCP_OPT_BOUNDARY_ALPHA, .kind = SCP_KIND_F64, .v.f = 0.3},
-      {.name = SCP_OPT_PAPER_PRUNING, .kind = SCP_KIND_U64, .v.u = 1},
-      {.name = SCP_OPT_WATERTIGHT_LABELS, .kind = SCP_KIND_U64, .v.u = 1},
+      {.name = "boundary_rho", .kind = SCP_KIND_F64, .v.f = 0.05},
+      {.name = "max_hole_edges", .kind = SCP_KIND_U64, .v.u = 0},
+      {.name = "boundary_alpha", .kind = SCP_KIND_F64, .v.f = 0.3},
+      {.name = "paper_pruning", .kind = SCP_KIND_U64, .v.u = 1},
+      {.name = "watertight_labels", .kind = SCP_KIND_U64, .v.u = 1},
       /* Given twice: the first value counts. */
-      {.name = SCP_OPT_BOUNDARY_RHO, .kind = SCP_KIND_F64, .v.f = 5}};
+      {.name = "boundary_rho", .kind = SCP_KIND_F64, .v.f = 5}};
   scdt_job_t with, without;
   scdt_job_init(&with, 1, torus, N);
   with.mode = SCP_MODE_BOUNDARY;
@@ -145,15 +145,15 @@ static void options_refused(void) {
   } cases[] = {
       {{.name = "smoothing", .kind = SCP_KIND_U64, .v.u = 1},
        SCP_WIRE_UNSUPPORTED, "smoothing"},
-      {{.name = SCP_OPT_MAX_HOLE_EDGES, .kind = SCP_KIND_F64, .v.f = 10},
+      {{.name = "max_hole_edges", .kind = SCP_KIND_F64, .v.f = 10},
        SCP_WIRE_INVALID, "must be an unsigned integer"},
-      {{.name = SCP_OPT_MAX_HOLE_EDGES, .kind = SCP_KIND_U64, .v.u = 100001},
+      {{.name = "max_hole_edges", .kind = SCP_KIND_U64, .v.u = 100001},
        SCP_WIRE_INVALID, "out of range"},
-      {{.name = SCP_OPT_BOUNDARY_RHO, .kind = SCP_KIND_F64, .v.f = 0},
+      {{.name = "boundary_rho", .kind = SCP_KIND_F64, .v.f = 0},
        SCP_WIRE_INVALID, "out of range"},
-      {{.name = SCP_OPT_BOUNDARY_ALPHA, .kind = SCP_KIND_F64, .v.f = 2},
+      {{.name = "boundary_alpha", .kind = SCP_KIND_F64, .v.f = 2},
        SCP_WIRE_INVALID, "out of range"},
-      {{.name = SCP_OPT_PAPER_PRUNING, .kind = SCP_KIND_U64, .v.u = 2},
+      {{.name = "paper_pruning", .kind = SCP_KIND_U64, .v.u = 2},
        SCP_WIRE_INVALID, "out of range"},
   };
   for (uint32_t i = 0; i < sizeof cases / sizeof cases[0]; i++)

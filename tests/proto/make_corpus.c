@@ -104,8 +104,8 @@ static void job_begin(scp_buf_t *b) {
 static void job_begin_options(scp_buf_t *b) {
   scp_job_begin_t jb = {.job_id = 9, .mode = SCP_MODE_BOUNDARY, .r = 0.18};
   const scp_value_t o[] = {
-      {.name = SCP_OPT_MAX_HOLE_EDGES, .kind = SCP_KIND_U64, .v.u = 0},
-      {.name = SCP_OPT_BOUNDARY_ALPHA, .kind = SCP_KIND_F64, .v.f = 0.4}};
+      {.name = "max_hole_edges", .kind = SCP_KIND_U64, .v.u = 0},
+      {.name = "boundary_alpha", .kind = SCP_KIND_F64, .v.f = 0.4}};
   E(scp_enc_job_begin_options(b, &jb, o, 2));
 }
 

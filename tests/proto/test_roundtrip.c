@@ -187,8 +187,8 @@ static void test_job_frames(void) {
   /* With job options: written back byte for byte from the view, and read
    * back entry by entry. */
   const scp_value_t opts[] = {
-      {.name = SCP_OPT_MAX_HOLE_EDGES, .kind = SCP_KIND_U64, .v.u = 0},
-      {.name = SCP_OPT_BOUNDARY_RHO, .kind = SCP_KIND_F64, .v.f = 1.25},
+      {.name = "max_hole_edges", .kind = SCP_KIND_U64, .v.u = 0},
+      {.name = "boundary_rho", .kind = SCP_KIND_F64, .v.f = 1.25},
       {.name = "later.option", .kind = 200, .v.u = 0x0102030405060708u}};
   jb = (scp_job_begin_t){.job_id = 3, .mode = SCP_MODE_BOUNDARY, .r = 0.18};
   ASSERT_CODE_EQ(scp_enc_job_begin_options(&b, &jb, opts, 3), 0, scp_err_name);
