@@ -359,6 +359,21 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
           d->seconds_total);
 }
 
+/* Writes s to f as a JSON string: quoted, with the quote and the backslash
+ * escaped and control characters as \u00XX; NULL is written as "". */
+static void json_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *p = (const unsigned char *)s; p && *p; ++p) {
+    if (*p == '"' || *p == '\\')
+      fprintf(f, "\\%c", *p);
+    else if (*p < 0x20)
+      fprintf(f, "\\u%04x", *p);
+    else
+      fputc(*p, f);
+  }
+  fputc('"', f);
+}
+
 char *sc_cli_report_json(const sc_cli_result_t *r) {
   char *buf = NULL;
   size_t len = 0;
@@ -367,13 +382,13 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
     return NULL;
   const sc_diag_t *d = r->diag;
   fputs("{\n  \"command\": ", f);
-  sc_file_json_string(f, r->command);
+  json_string(f, r->command);
   fputs(",\n  \"input\": ", f);
-  sc_file_json_string(f, r->input);
+  json_string(f, r->input);
   fputs(",\n  \"output\": ", f);
-  sc_file_json_string(f, r->output);
+  json_string(f, r->output);
   fputs(",\n  \"params\": {\"mode\": ", f);
-  sc_file_json_string(f, sc_cli_mode_name(r->params.mode));
+  json_string(f, sc_cli_mode_name(r->params.mode));
   fprintf(f,
           ", \"r\": %.17g, \"cocone_theta\": %.17g, \"paper_pruning\": %d, "
           "\"max_hole_edges\": %d, \"threads\": %d, \"boundary_rho\": %.17g, "
@@ -410,7 +425,7 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
   U64_(handles_cut);
 #undef U64_
   fputs("  \"path\": ", f);
-  sc_file_json_string(f, sc_path_name(d->path));
+  json_string(f, sc_path_name(d->path));
   fprintf(f, ",\n  \"loops_by_length\": [%llu, %llu, %llu, %llu],\n",
           (unsigned long long)d->loops_by_length[0],
           (unsigned long long)d->loops_by_length[1],

@@ -2051,16 +2051,3 @@ int sc_mesh_write(const char *path, sc_mesh_format_t fmt, const double *xyz,
     aout_abort(&o);
   return rc;
 }
-
-void sc_file_json_string(FILE *f, const char *s) {
-  fputc('"', f);
-  for (const unsigned char *p = (const unsigned char *)s; p && *p; ++p) {
-    if (*p == '"' || *p == '\\')
-      fprintf(f, "\\%c", *p);
-    else if (*p < 0x20)
-      fprintf(f, "\\u%04x", *p);
-    else
-      fputc(*p, f);
-  }
-  fputc('"', f);
-}

@@ -23,7 +23,6 @@
 
 #include <stddef.h>
 #include <stdint.h>
-#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -154,11 +153,6 @@ int sc_mesh_write(const char *path, sc_mesh_format_t fmt, const double *xyz,
  */
 int sc_file_write_atomic(const char *path, const void *data, size_t len,
                          char *msg, size_t msg_len);
-
-/* Writes s to f as a JSON string: quoted, with the quote and the backslash
- * escaped and control characters as \u00XX; NULL is written as "". For the
- * reports. */
-void sc_file_json_string(FILE *f, const char *s);
 
 #ifdef __cplusplus
 }

@@ -344,6 +344,21 @@ static sc_client_value_t *daemon_stats(const config_t *cfg, size_t *n) {
   return v;
 }
 
+/* Writes s to f as a JSON string: quoted, with the quote and the backslash
+ * escaped and control characters as \u00XX; NULL is written as "". */
+static void json_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *p = (const unsigned char *)s; p && *p; ++p) {
+    if (*p == '"' || *p == '\\')
+      fprintf(f, "\\%c", *p);
+    else if (*p < 0x20)
+      fprintf(f, "\\u%04x", *p);
+    else
+      fputc(*p, f);
+  }
+  fputc('"', f);
+}
+
 static void json_values(FILE *f, const sc_client_value_t *v, size_t n) {
   if (!v) {
     fputs("null", f);
@@ -768,7 +783,7 @@ int main(int argc, char **argv) {
            (unsigned long long)all.failed);
     for (size_t k = 0; k < all.ncodes; k++) {
       printf("%s", k ? ", " : "");
-      sc_file_json_string(stdout, all.codes[k].name);
+      json_string(stdout, all.codes[k].name);
       printf(": %llu", (unsigned long long)all.codes[k].count);
     }
     printf("}, \"verify\": %s, \"verified\": %llu, \"verify_failures\": %llu, "
