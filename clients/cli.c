@@ -16,7 +16,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "files.h"
+#include "shortcrust_files.h"
 
 void sc_cli_error(const char *fmt, ...) {
   va_list ap;
@@ -459,7 +459,7 @@ int sc_cli_write_report(const char *path, const sc_cli_result_t *r) {
     return -1;
   }
   char msg[512];
-  int rc = sc_file_write_atomic(path, json, strlen(json), msg, sizeof msg);
+  int rc = scf_write_atomic(path, json, strlen(json), msg, sizeof msg);
   free(json);
   if (rc < 0) {
     sc_cli_error("%s", msg);
@@ -469,10 +469,10 @@ int sc_cli_write_report(const char *path, const sc_cli_result_t *r) {
 }
 
 int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
-                    sc_mesh_format_t *fmt, sc_points_t *pts,
+                    scf_mesh_format_t *fmt, scf_points_t *pts,
                     double *seconds_read) {
   char msg[1024];
-  if (sc_mesh_format_from_path(o->out_path, o->ascii, fmt, msg, sizeof msg) <
+  if (scf_mesh_format_from_path(o->out_path, o->ascii, fmt, msg, sizeof msg) <
       0) {
     sc_cli_error("%s", msg);
     return SC_EXIT_USAGE;
@@ -480,7 +480,7 @@ int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
   sc_cli_progress_init(progress, o->quiet);
   double t0 = sc_cli_now();
   sc_cli_progress_step(progress, "reading", 0);
-  if (sc_points_read(o->in_path, pts, msg, sizeof msg) < 0) {
+  if (scf_points_read(o->in_path, pts, msg, sizeof msg) < 0) {
     sc_cli_progress_done(progress);
     sc_cli_error("%s", msg);
     return SC_EXIT_FAILURE;
@@ -490,14 +490,14 @@ int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
 }
 
 int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
-                     sc_mesh_format_t fmt, const sc_points_t *pts,
-                     const uint32_t *tris, size_t ntri,
-                     const double *normals, sc_cli_result_t *r) {
+                     scf_mesh_format_t fmt, const scf_points_t *pts,
+                     const uint32_t *tris, size_t ntri, const double *normals,
+                     sc_cli_result_t *r) {
   char msg[1024];
   sc_cli_progress_step(progress, "writing", 0);
   double t0 = sc_cli_now();
-  int rc = sc_mesh_write(o->out_path, fmt, pts->xyz, pts->count, tris, ntri,
-                         o->normals ? normals : NULL, msg, sizeof msg);
+  int rc = scf_mesh_write(o->out_path, fmt, pts->xyz, pts->count, tris, ntri,
+                          o->normals ? normals : NULL, msg, sizeof msg);
   r->seconds_write = sc_cli_now() - t0;
   sc_cli_progress_done(progress);
   if (rc < 0) {

@@ -34,8 +34,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "files.h"
 #include "scproto.h"
+#include "shortcrust_files.h"
 
 #define SCC_PI 3.14159265358979323846
 #define SCC_READ_SIZE (64 * 1024)
@@ -1341,15 +1341,15 @@ int sc_client_submit_file(sc_client_t *c, const sc_client_params_t *params,
   int rc = usable(c);
   if (rc < 0)
     return rc;
-  sc_points_t pts;
+  scf_points_t pts;
   char msg[SCC_MSG_MAX];
-  rc = sc_points_read(path, &pts, msg, sizeof msg);
+  rc = scf_points_read(path, &pts, msg, sizeof msg);
   if (rc < 0)
-    return fail(c, rc == SC_FILE_ENOMEM ? SC_CLIENT_ENOMEM : SC_CLIENT_EFILE,
-                "%s", msg);
+    return fail(c, rc == SCF_ENOMEM ? SC_CLIENT_ENOMEM : SC_CLIENT_EFILE, "%s",
+                msg);
   rc = submit(c, params, pts.xyz, pts.count, pts.xyz, job);
   if (rc < 0)
-    sc_points_free(&pts);
+    scf_points_free(&pts);
   return rc;
 }
 

@@ -28,8 +28,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "files.h"
 #include "shortcrust_client.h"
+#include "shortcrust_files.h"
 #include "testsupport.h"
 
 #ifndef SC_VERSION
@@ -628,9 +628,9 @@ int main(int argc, char **argv) {
     cfg.inputs = calloc(cfg.ninputs, sizeof *cfg.inputs);
     for (size_t i = 0; cfg.inputs && i < nfiles; i++) {
       input_t *in = &cfg.inputs[i];
-      sc_points_t pts;
+      scf_points_t pts;
       char msg[1024];
-      if (sc_points_read(files[i], &pts, msg, sizeof msg) < 0) {
+      if (scf_points_read(files[i], &pts, msg, sizeof msg) < 0) {
         say("%s", msg);
         return 1;
       }

@@ -1,5 +1,5 @@
 /*
- * Point and mesh files (see files.h for the contract).
+ * Point and mesh files (see shortcrust_files.h for the contract).
  *
  * Reading goes through rd_t, a fixed buffer over a file descriptor that
  * knows the byte offset and line number of what it hands out, so that every
@@ -15,7 +15,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "files.h"
+#include "shortcrust_files.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -34,29 +34,29 @@
 
 typedef unsigned long long ull;
 
-const char *sc_file_strerror(int code) {
+const char *scf_strerror(int code) {
   switch (code) {
-  case SC_FILE_OK:
+  case SCF_OK:
     return "success";
-#define SC_FILE_ERR_TEXT_(name, value, text)                                   \
-  case SC_FILE_E##name:                                                        \
+#define SCF_ERR_TEXT_(name, value, text)                                   \
+  case SCF_E##name:                                                        \
     return text;
-    SC_FILE_ERRNO_MAP(SC_FILE_ERR_TEXT_)
-#undef SC_FILE_ERR_TEXT_
+    SCF_ERRNO_MAP(SCF_ERR_TEXT_)
+#undef SCF_ERR_TEXT_
   default:
     return "unknown error";
   }
 }
 
-const char *sc_file_err_name(int code) {
+const char *scf_err_name(int code) {
   switch (code) {
-  case SC_FILE_OK:
+  case SCF_OK:
     return "OK";
-#define SC_FILE_ERR_NAME_(name, value, text)                                   \
-  case SC_FILE_E##name:                                                        \
+#define SCF_ERR_NAME_(name, value, text)                                   \
+  case SCF_E##name:                                                        \
     return "E" #name;
-    SC_FILE_ERRNO_MAP(SC_FILE_ERR_NAME_)
-#undef SC_FILE_ERR_NAME_
+    SCF_ERRNO_MAP(SCF_ERR_NAME_)
+#undef SCF_ERR_NAME_
   default:
     return "UNKNOWN";
   }
@@ -192,21 +192,21 @@ static int rd_open(rd_t *r, const char *path, char *msg, size_t msg_len) {
   r->fd = open(path, O_RDONLY | O_CLOEXEC);
   if (r->fd < 0) {
     int e = errno;
-    return fail(msg, msg_len, e == ENOENT ? SC_FILE_ENOENT : SC_FILE_EIO,
+    return fail(msg, msg_len, e == ENOENT ? SCF_ENOENT : SCF_EIO,
                 path, "cannot open: %s", strerror(e));
   }
   struct stat st;
   if (fstat(r->fd, &st) != 0)
-    return fail(msg, msg_len, SC_FILE_EIO, path, "cannot stat: %s",
+    return fail(msg, msg_len, SCF_EIO, path, "cannot stat: %s",
                 strerror(errno));
   if (S_ISDIR(st.st_mode))
-    return fail(msg, msg_len, SC_FILE_EIO, path,
+    return fail(msg, msg_len, SCF_EIO, path,
                 "is a directory, not a file");
   if (S_ISREG(st.st_mode))
     r->size = (uint64_t)st.st_size;
   r->buf = malloc(RD_CAP + 1);
   if (r->buf == NULL)
-    return fail(msg, msg_len, SC_FILE_ENOMEM, path,
+    return fail(msg, msg_len, SCF_ENOMEM, path,
                 "out of memory for the read buffer");
   return 0;
 }
@@ -242,7 +242,7 @@ static int rd_fill(rd_t *r) {
     if (n < 0) {
       if (errno == EINTR)
         continue;
-      return rd_fail_byte(r, r->base + r->end, SC_FILE_EIO,
+      return rd_fail_byte(r, r->base + r->end, SCF_EIO,
                           "read failed: %s", strerror(errno));
     }
     if (n == 0)
@@ -281,7 +281,7 @@ static int rd_line(rd_t *r, char **line) {
       break;
     }
     if (avail >= RD_CAP)
-      return rd_fail_line(r, r->line + 1, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line + 1, SCF_EFORMAT,
                           "line longer than %zu bytes", RD_CAP);
     scanned = avail;
     int rc = rd_fill(r);
@@ -293,7 +293,7 @@ static int rd_line(rd_t *r, char **line) {
     start[--len] = '\0';
   /* A NUL would silently cut the line short; it means a binary file. */
   if (memchr(start, '\0', len) != NULL)
-    return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+    return rd_fail_line(r, r->line, SCF_EFORMAT,
                         "NUL byte in a text line (a binary file?)");
   *line = (char *)start;
   return 1;
@@ -357,11 +357,11 @@ static int vbuf_reserve(rd_t *r, vbuf_t *v, uint64_t cap) {
   if (cap <= v->cap)
     return 0;
   if (cap > SIZE_MAX / (3 * sizeof(double)))
-    return fail(r->msg, r->msg_len, SC_FILE_ENOMEM, r->path,
+    return fail(r->msg, r->msg_len, SCF_ENOMEM, r->path,
                 "too many points for memory (%llu)", (ull)cap);
   double *p = realloc(v->xyz, (size_t)cap * 3 * sizeof(double));
   if (p == NULL)
-    return fail(r->msg, r->msg_len, SC_FILE_ENOMEM, r->path,
+    return fail(r->msg, r->msg_len, SCF_ENOMEM, r->path,
                 "out of memory for %llu points", (ull)cap);
   v->xyz = p;
   v->cap = (size_t)cap;
@@ -385,11 +385,11 @@ static int tbuf_push(rd_t *r, tbuf_t *t, uint32_t a, uint32_t b, uint32_t c) {
   if (t->count == t->cap) {
     size_t cap = t->cap ? t->cap * 2 : 4096;
     if (cap < t->cap || cap > SIZE_MAX / (3 * sizeof(uint32_t)))
-      return fail(r->msg, r->msg_len, SC_FILE_ENOMEM, r->path,
+      return fail(r->msg, r->msg_len, SCF_ENOMEM, r->path,
                   "too many triangles for memory");
     uint32_t *p = realloc(t->idx, cap * 3 * sizeof(uint32_t));
     if (p == NULL)
-      return fail(r->msg, r->msg_len, SC_FILE_ENOMEM, r->path,
+      return fail(r->msg, r->msg_len, SCF_ENOMEM, r->path,
                   "out of memory after %zu triangles", t->count);
     t->idx = p;
     t->cap = cap;
@@ -515,10 +515,10 @@ static int three_numbers(char **cur, const char *seps, double c[3],
 static int bad_numbers(rd_t *r, const char *what, const char *bad, int ntok) {
   char buf[SHOW_MAX + 4];
   if (bad != NULL)
-    return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+    return rd_fail_line(r, r->line, SCF_EFORMAT,
                         "expected 3 numbers%s, got '%s'", what,
                         show(bad, buf));
-  return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+  return rd_fail_line(r, r->line, SCF_EFORMAT,
                       "expected 3 numbers%s, got %d", what, ntok);
 }
 
@@ -676,10 +676,10 @@ static int ply_header_line(rd_t *r, ply_t *p, char *line, int *done) {
   if (strcmp(kw, "format") == 0) {
     char *fmt = next_tok(&cur, WS), *ver = next_tok(&cur, WS);
     if (p->format != 0)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "second format line in the header");
     if (fmt == NULL || ver == NULL)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "expected 'format <type> 1.0'");
     if (strcmp(fmt, "ascii") == 0)
       p->format = PLY_ASCII;
@@ -688,12 +688,12 @@ static int ply_header_line(rd_t *r, ply_t *p, char *line, int *done) {
     else if (strcmp(fmt, "binary_big_endian") == 0)
       p->format = PLY_BE;
     else
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "unknown PLY format '%s' (expected ascii, "
                           "binary_little_endian or binary_big_endian)",
                           show(fmt, buf));
     if (strcmp(ver, "1.0") != 0)
-      return rd_fail_line(r, r->line, SC_FILE_EUNSUPPORTED,
+      return rd_fail_line(r, r->line, SCF_EUNSUPPORTED,
                           "PLY version '%s' (only 1.0 is supported)",
                           show(ver, buf));
     return 0;
@@ -701,20 +701,20 @@ static int ply_header_line(rd_t *r, ply_t *p, char *line, int *done) {
   if (strcmp(kw, "element") == 0) {
     char *name = next_tok(&cur, WS), *count = next_tok(&cur, WS);
     if (name == NULL || count == NULL)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "expected 'element <name> <count>'");
     uint64_t n;
     if (parse_u64(count, &n) < 0)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "expected a count for element '%s', got '%s'",
                           name, show(count, buf));
     if (p->n_elems == PLY_MAX_ELEMENTS)
-      return rd_fail_line(r, r->line, SC_FILE_EUNSUPPORTED,
+      return rd_fail_line(r, r->line, SCF_EUNSUPPORTED,
                           "more than %d elements", PLY_MAX_ELEMENTS);
     if (p->n_elems % 8 == 0) {
       ply_elem_t *e = realloc(p->elems, (p->n_elems + 8) * sizeof *e);
       if (e == NULL)
-        return rd_fail_line(r, r->line, SC_FILE_ENOMEM, "out of memory");
+        return rd_fail_line(r, r->line, SCF_ENOMEM, "out of memory");
       p->elems = e;
     }
     ply_elem_t *e = &p->elems[p->n_elems++];
@@ -726,7 +726,7 @@ static int ply_header_line(rd_t *r, ply_t *p, char *line, int *done) {
   }
   if (strcmp(kw, "property") == 0) {
     if (p->n_elems == 0)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "property before any element");
     ply_elem_t *e = &p->elems[p->n_elems - 1];
     ply_prop_t prop;
@@ -735,34 +735,34 @@ static int ply_header_line(rd_t *r, ply_t *p, char *line, int *done) {
     if (type != NULL && strcmp(type, "list") == 0) {
       char *ct = next_tok(&cur, WS);
       if (ct == NULL)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "expected 'property list <count type> <item "
                             "type> <name>'");
       prop.count_type = ply_type_of(ct);
       if (!ply_type_is_int(prop.count_type))
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "list count type '%s' is not an integer type",
                             show(ct, buf));
       type = next_tok(&cur, WS);
     }
     char *name = next_tok(&cur, WS);
     if (type == NULL || name == NULL)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "expected 'property <type> <name>'");
     prop.type = ply_type_of(type);
     if (prop.type == PT_NONE)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "unknown property type '%s'", show(type, buf));
     copy_name(prop.name, name);
     if (e->n_props == PLY_MAX_PROPS)
-      return rd_fail_line(r, r->line, SC_FILE_EUNSUPPORTED,
+      return rd_fail_line(r, r->line, SCF_EUNSUPPORTED,
                           "more than %d properties in element '%s'",
                           PLY_MAX_PROPS, e->name);
     if (e->n_props == e->cap_props) {
       size_t cap = e->cap_props ? e->cap_props * 2 : 8;
       ply_prop_t *np = realloc(e->props, cap * sizeof *np);
       if (np == NULL)
-        return rd_fail_line(r, r->line, SC_FILE_ENOMEM, "out of memory");
+        return rd_fail_line(r, r->line, SCF_ENOMEM, "out of memory");
       e->props = np;
       e->cap_props = cap;
     }
@@ -776,7 +776,7 @@ static int ply_header_line(rd_t *r, ply_t *p, char *line, int *done) {
     e->props[e->n_props++] = prop;
     return 0;
   }
-  return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+  return rd_fail_line(r, r->line, SCF_EFORMAT,
                       "unknown header keyword '%s'", show(kw, buf));
 }
 
@@ -793,14 +793,14 @@ static int ply_header(rd_t *r, ply_t *p, int want_faces) {
   if (rc < 0)
     return rc;
   if (rc == 0 || strcmp(line, "ply") != 0)
-    return rd_fail_line(r, 1, SC_FILE_EFORMAT,
+    return rd_fail_line(r, 1, SCF_EFORMAT,
                         "not a PLY file: the first line is not 'ply'");
   for (int done = 0; !done;) {
     rc = rd_line(r, &line);
     if (rc < 0)
       return rc;
     if (rc == 0)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "file ends inside the header (no end_header)");
     rc = ply_header_line(r, p, line, &done);
     if (rc < 0)
@@ -808,13 +808,13 @@ static int ply_header(rd_t *r, ply_t *p, int want_faces) {
   }
   p->header_end = r->line;
   if (p->format == 0)
-    return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+    return rd_fail_line(r, r->line, SCF_EFORMAT,
                         "no format line in the header");
   p->vertex = p->face = -1;
   for (size_t i = 0; i < p->n_elems; i++) {
     if (strcmp(p->elems[i].name, "vertex") == 0) {
       if (p->vertex >= 0)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "two vertex elements in the header");
       p->vertex = (int)i;
     } else if (want_faces && p->face < 0 &&
@@ -823,7 +823,7 @@ static int ply_header(rd_t *r, ply_t *p, int want_faces) {
     }
   }
   if (p->vertex < 0)
-    return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+    return rd_fail_line(r, r->line, SCF_EFORMAT,
                         "no vertex element in the header");
   const ply_elem_t *v = &p->elems[p->vertex];
   int *slots[3] = {&p->px, &p->py, &p->pz};
@@ -831,11 +831,11 @@ static int ply_header(rd_t *r, ply_t *p, int want_faces) {
   for (int a = 0; a < 3; a++) {
     *slots[a] = ply_find_prop(v, axes[a]);
     if (*slots[a] < 0)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "the vertex element has no property '%s'",
                           axes[a]);
     if (v->props[*slots[a]].count_type != PT_NONE)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "vertex property '%s' is a list", axes[a]);
   }
   p->pface = -1;
@@ -845,13 +845,13 @@ static int ply_header(rd_t *r, ply_t *p, int want_faces) {
     if (p->pface < 0)
       p->pface = ply_find_prop(f, "vertex_index");
     if (p->pface < 0 || f->props[p->pface].count_type == PT_NONE)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "the face element has no vertex_indices list");
     if (!ply_type_is_int(f->props[p->pface].type))
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "face vertex indices are not of an integer type");
     if (v->count > UINT32_MAX)
-      return rd_fail_line(r, r->line, SC_FILE_EUNSUPPORTED,
+      return rd_fail_line(r, r->line, SCF_EUNSUPPORTED,
                           "%llu vertices: meshes with more than 2^32 - 1 "
                           "vertices are not supported",
                           (ull)v->count);
@@ -873,10 +873,10 @@ static int ply_truncated(rd_t *r, uint64_t rec, uint64_t at,
                          const ply_elem_t *e, uint64_t k, uint64_t expected,
                          uint64_t got) {
   if (got == 0 && at == rec)
-    return rd_fail_byte(r, at, SC_FILE_EFORMAT,
+    return rd_fail_byte(r, at, SCF_EFORMAT,
                         "file ends before %s %llu of %llu", e->name, (ull)k,
                         (ull)e->count);
-  return rd_fail_byte(r, at, SC_FILE_EFORMAT,
+  return rd_fail_byte(r, at, SCF_EFORMAT,
                       "file ends inside %s %llu of %llu (expected %llu "
                       "bytes, got %llu)",
                       e->name, (ull)k, (ull)e->count, (ull)expected,
@@ -907,7 +907,7 @@ static int ply_check_size(rd_t *r, const ply_t *p) {
     }
     if (p->format == PLY_ASCII)
       return rd_fail_line(
-          r, p->header_end, SC_FILE_EFORMAT,
+          r, p->header_end, SCF_EFORMAT,
           "the header declares %llu %s records; with the elements before "
           "them they need at least %llu bytes, but only %llu bytes follow "
           "the header",
@@ -921,7 +921,7 @@ static int ply_check_size(rd_t *r, const ply_t *p) {
                            left % e->rec_size);
     }
     return rd_fail_byte(
-        r, rd_offset(r), SC_FILE_EFORMAT,
+        r, rd_offset(r), SCF_EFORMAT,
         "the header declares %llu %s records; with the elements before them "
         "they need at least %llu bytes, but only %llu bytes follow the "
         "header",
@@ -946,9 +946,9 @@ static int ply_check_index(rd_t *r, const ply_t *p, int64_t idx,
   const char *fmt = "face %llu refers to vertex %lld, but there are %llu "
                     "vertices";
   if (binary)
-    return rd_fail_byte(r, at, SC_FILE_EFORMAT, fmt, (ull)k, (long long)idx,
+    return rd_fail_byte(r, at, SCF_EFORMAT, fmt, (ull)k, (long long)idx,
                         (ull)nv);
-  return rd_fail_line(r, at, SC_FILE_EFORMAT, fmt, (ull)k, (long long)idx,
+  return rd_fail_line(r, at, SCF_EFORMAT, fmt, (ull)k, (long long)idx,
                       (ull)nv);
 }
 
@@ -1021,13 +1021,13 @@ static int ply_binary_elem(rd_t *r, const ply_t *p, size_t ei, vbuf_t *v,
         return ply_truncated(r, rec, at, e, k, csz, got);
       int64_t n = ply_int(b, pp->count_type, be);
       if (n < 0)
-        return rd_fail_byte(r, at, SC_FILE_EFORMAT,
+        return rd_fail_byte(r, at, SCF_EFORMAT,
                             "negative list length %lld in %s %llu",
                             (long long)n, e->name, (ull)k);
       size_t isz = ply_type_size(pp->type);
       if (role == ROLE_FACE && (int)j == p->pface) {
         if (n < 3)
-          return rd_fail_byte(r, at, SC_FILE_EFORMAT,
+          return rd_fail_byte(r, at, SCF_EFORMAT,
                               "face %llu has %lld vertices (expected at "
                               "least 3)",
                               (ull)k, (long long)n);
@@ -1082,7 +1082,7 @@ static int ply_ascii_value(tokens_t *ts, const ply_elem_t *e, uint64_t k,
   if (rc < 0)
     return rc;
   if (rc == 0)
-    return rd_fail_line(ts->r, ts->r->line, SC_FILE_EFORMAT,
+    return rd_fail_line(ts->r, ts->r->line, SCF_EFORMAT,
                         "file ends inside %s %llu of %llu (expected %s)",
                         e->name, (ull)k, (ull)e->count, what);
   return 0;
@@ -1111,7 +1111,7 @@ static int ply_ascii_elem(tokens_t *ts, const ply_t *p, size_t ei, vbuf_t *v,
       if (pp->count_type == PT_NONE) {
         double d;
         if (parse_double(tok, &d) < 0)
-          return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+          return rd_fail_line(r, r->line, SCF_EFORMAT,
                               "expected a number for property '%s' of %s "
                               "%llu, got '%s'",
                               pp->name, e->name, (ull)k, show(tok, buf));
@@ -1127,13 +1127,13 @@ static int ply_ascii_elem(tokens_t *ts, const ply_t *p, size_t ei, vbuf_t *v,
       }
       int64_t n;
       if (parse_i64(tok, &n) < 0 || n < 0)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "expected a list length for '%s' of %s %llu, "
                             "got '%s'",
                             pp->name, e->name, (ull)k, show(tok, buf));
       int is_face = role == ROLE_FACE && (int)j == p->pface;
       if (is_face && n < 3)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "face %llu has %lld vertices (expected at "
                             "least 3)",
                             (ull)k, (long long)n);
@@ -1145,7 +1145,7 @@ static int ply_ascii_elem(tokens_t *ts, const ply_t *p, size_t ei, vbuf_t *v,
         if (is_face) {
           int64_t idx;
           if (parse_i64(tok, &idx) < 0)
-            return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+            return rd_fail_line(r, r->line, SCF_EFORMAT,
                                 "expected a vertex index in face %llu, got "
                                 "'%s'",
                                 (ull)k, show(tok, buf));
@@ -1155,7 +1155,7 @@ static int ply_ascii_elem(tokens_t *ts, const ply_t *p, size_t ei, vbuf_t *v,
         } else {
           double d;
           if (parse_double(tok, &d) < 0)
-            return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+            return rd_fail_line(r, r->line, SCF_EFORMAT,
                                 "expected a number in list '%s' of %s %llu, "
                                 "got '%s'",
                                 pp->name, e->name, (ull)k, show(tok, buf));
@@ -1261,31 +1261,31 @@ static int read_off(rd_t *r, vbuf_t *v, tbuf_t *t) {
   tok = rc ? next_tok(&cur, WS) : NULL;
   int kw = tok ? off_keyword(tok) : 0;
   if (kw < 0)
-    return rd_fail_line(r, r->line, SC_FILE_EUNSUPPORTED,
+    return rd_fail_line(r, r->line, SCF_EUNSUPPORTED,
                         "'%s' files (not three coordinates) are not "
                         "supported",
                         show(tok, buf));
   if (kw == 0)
-    return rd_fail_line(r, rc ? r->line : 1, SC_FILE_EFORMAT,
+    return rd_fail_line(r, rc ? r->line : 1, SCF_EFORMAT,
                         "not an OFF file: expected 'OFF' first, got '%s'",
                         tok ? show(tok, buf) : "");
   tok = next_tok(&cur, WS);
   if (tok != NULL && strcmp(tok, "BINARY") == 0)
-    return rd_fail_line(r, r->line, SC_FILE_EUNSUPPORTED,
+    return rd_fail_line(r, r->line, SCF_EUNSUPPORTED,
                         "binary OFF is not supported");
   /* The counts may follow the keyword on the same line. */
   if (tok == NULL) {
     if ((rc = next_content_line(r, &cur)) < 0)
       return rc;
     if (rc == 0)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "file ends before the vertex and face counts");
     tok = next_tok(&cur, WS);
   }
   char *ftok = next_tok(&cur, WS);
   uint64_t nv, nf;
   if (parse_u64(tok, &nv) < 0 || ftok == NULL || parse_u64(ftok, &nf) < 0)
-    return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+    return rd_fail_line(r, r->line, SCF_EFORMAT,
                         "expected the vertex and face counts, got '%s'",
                         show(tok, buf));
   uint64_t rem = rd_remaining(r);
@@ -1293,13 +1293,13 @@ static int read_off(rd_t *r, vbuf_t *v, tbuf_t *t) {
   uint64_t need = sat_mul_add(sat_mul_add(0, nv, 6), t ? nf : 0, 8);
   if (rem != UINT64_MAX && need > 0 && need - 1 > rem)
     return rd_fail_line(r, r->line,
-                        SC_FILE_EFORMAT,
+                        SCF_EFORMAT,
                         "the header declares %llu vertices%s%s, which need "
                         "at least %llu bytes, but only %llu bytes follow",
                         (ull)nv, t ? " and faces " : "", t ? ftok : "",
                         (ull)(need - 1), (ull)rem);
   if (t != NULL && nv > UINT32_MAX)
-    return rd_fail_line(r, r->line, SC_FILE_EUNSUPPORTED,
+    return rd_fail_line(r, r->line, SCF_EUNSUPPORTED,
                         "meshes with more than 2^32 - 1 vertices are not "
                         "supported");
   if (nv > 0 && (rc = vbuf_reserve(r, v, rem == UINT64_MAX && nv > 65536
@@ -1310,7 +1310,7 @@ static int read_off(rd_t *r, vbuf_t *v, tbuf_t *t) {
     if ((rc = next_content_line(r, &cur)) < 0)
       return rc;
     if (rc == 0)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "file ends after %llu of %llu vertices", (ull)k,
                           (ull)nv);
     double xyz[3];
@@ -1325,13 +1325,13 @@ static int read_off(rd_t *r, vbuf_t *v, tbuf_t *t) {
     if ((rc = next_content_line(r, &cur)) < 0)
       return rc;
     if (rc == 0)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "file ends after %llu of %llu faces", (ull)k,
                           (ull)nf);
     tok = next_tok(&cur, WS);
     int64_t n;
     if (parse_i64(tok, &n) < 0 || n < 3)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "expected a vertex count of at least 3 for face "
                           "%llu, got '%s'",
                           (ull)k, show(tok, buf));
@@ -1340,11 +1340,11 @@ static int read_off(rd_t *r, vbuf_t *v, tbuf_t *t) {
       int64_t idx;
       tok = next_tok(&cur, WS);
       if (tok == NULL)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "face %llu has %lld of its %lld vertex indices",
                             (ull)k, (long long)i, (long long)n);
       if (parse_i64(tok, &idx) < 0 || idx < 0 || (uint64_t)idx >= nv)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "expected a vertex index below %llu in face "
                             "%llu, got '%s'",
                             (ull)nv, (ull)k, show(tok, buf));
@@ -1390,18 +1390,18 @@ static int read_obj(rd_t *r, vbuf_t *v, tbuf_t *t) {
         *slash = '\0';
       int64_t i;
       if (parse_i64(tok, &i) < 0 || i == 0)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "expected a vertex index (1-based, or negative "
                             "from the last vertex), got '%s'",
                             show(tok, buf));
       int64_t idx = i > 0 ? i - 1 : (int64_t)v->count + i;
       if (idx < 0)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "relative vertex index %lld reaches before the "
                             "first vertex (%zu so far)",
                             (long long)i, v->count);
       if (idx > UINT32_MAX - 1)
-        return rd_fail_line(r, r->line, SC_FILE_EUNSUPPORTED,
+        return rd_fail_line(r, r->line, SCF_EUNSUPPORTED,
                             "vertex index %lld is beyond 2^32 - 1",
                             (long long)i);
       if (idx > max_idx) {
@@ -1412,14 +1412,14 @@ static int read_obj(rd_t *r, vbuf_t *v, tbuf_t *t) {
         return rc;
     }
     if (fan.n < 3)
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "face with %zu vertices (expected at least 3)",
                           fan.n);
   }
   if (rc < 0)
     return rc;
   if (max_idx >= 0 && (uint64_t)max_idx >= v->count)
-    return rd_fail_line(r, max_line, SC_FILE_EFORMAT,
+    return rd_fail_line(r, max_line, SCF_EFORMAT,
                         "face refers to vertex %lld, but the file has %zu "
                         "vertices",
                         (long long)max_idx + 1, v->count);
@@ -1451,32 +1451,32 @@ static int read_stl_ascii(rd_t *r, vbuf_t *v, tbuf_t *t) {
       const char *bad;
       int ntok;
       if (!in_loop || nloop == 3)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "vertex outside an 'outer loop' of three");
       if (three_numbers(&cur, WS, xyz, &bad, &ntok) < 0)
         return bad_numbers(r, " after 'vertex'", bad, ntok);
       if (v->count >= UINT32_MAX)
-        return rd_fail_line(r, r->line, SC_FILE_EUNSUPPORTED,
+        return rd_fail_line(r, r->line, SCF_EUNSUPPORTED,
                             "more than 2^32 - 1 vertices");
       if ((rc = vbuf_push(r, v, xyz[0], xyz[1], xyz[2])) < 0)
         return rc;
       nloop++;
     } else if (strcmp(kw, "endloop") == 0) {
       if (!in_loop || nloop != 3)
-        return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+        return rd_fail_line(r, r->line, SCF_EFORMAT,
                             "loop with %d vertices (expected 3)", nloop);
       uint32_t a = (uint32_t)(v->count - 3);
       if ((rc = tbuf_push(r, t, a, a + 1, a + 2)) < 0)
         return rc;
       in_loop = 0;
     } else {
-      return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+      return rd_fail_line(r, r->line, SCF_EFORMAT,
                           "expected an STL keyword, got '%s'",
                           show(kw, buf));
     }
   }
   if (rc == 0 && in_loop)
-    return rd_fail_line(r, r->line, SC_FILE_EFORMAT,
+    return rd_fail_line(r, r->line, SCF_EFORMAT,
                         "file ends inside a facet");
   return rc;
 }
@@ -1497,17 +1497,17 @@ static int read_stl(rd_t *r, vbuf_t *v, tbuf_t *t) {
   if (got >= 5 && memcmp(b, "solid", 5) == 0 && !sized)
     return read_stl_ascii(r, v, t);
   if (got < 84)
-    return rd_fail_byte(r, got, SC_FILE_EFORMAT,
+    return rd_fail_byte(r, got, SCF_EFORMAT,
                         "file ends inside the 84-byte binary STL header "
                         "(got %zu bytes)",
                         got);
   if (r->size != UINT64_MAX && r->size < 84 + 50 * n)
-    return rd_fail_byte(r, 80, SC_FILE_EFORMAT,
+    return rd_fail_byte(r, 80, SCF_EFORMAT,
                         "the header declares %llu triangles, which need "
                         "%llu bytes, but the file has %llu",
                         (ull)n, (ull)(84 + 50 * n), (ull)r->size);
   if (n > (UINT32_MAX - 1) / 3)
-    return rd_fail_byte(r, 80, SC_FILE_EUNSUPPORTED,
+    return rd_fail_byte(r, 80, SCF_EUNSUPPORTED,
                         "%llu triangles need more than 2^32 - 1 vertices",
                         (ull)n);
   r->pos += 84;
@@ -1520,7 +1520,7 @@ static int read_stl(rd_t *r, vbuf_t *v, tbuf_t *t) {
     if ((rc = rd_bytes(r, 50, &b, &got)) < 0)
       return rc;
     if (got < 50)
-      return rd_fail_byte(r, at, SC_FILE_EFORMAT,
+      return rd_fail_byte(r, at, SCF_EFORMAT,
                           "file ends inside triangle %llu of %llu (expected "
                           "50 bytes, got %zu)",
                           (ull)k, (ull)n, got);
@@ -1542,10 +1542,10 @@ static int unknown_extension(const char *path, char *msg, size_t msg_len,
   char ext[8];
   path_ext(path, ext);
   if (ext[0] == '\0')
-    return fail(msg, msg_len, SC_FILE_EUNSUPPORTED, path,
+    return fail(msg, msg_len, SCF_EUNSUPPORTED, path,
                 "no file extension to tell the format (expected %s)",
                 expected);
-  return fail(msg, msg_len, SC_FILE_EUNSUPPORTED, path,
+  return fail(msg, msg_len, SCF_EUNSUPPORTED, path,
               "unknown extension '.%s' (expected %s)", ext, expected);
 }
 
@@ -1557,7 +1557,7 @@ static void *shrink(void *p, size_t bytes) {
   return q ? q : p;
 }
 
-static int read_any(const char *path, sc_points_t *pts, uint32_t **tri,
+static int read_any(const char *path, scf_points_t *pts, uint32_t **tri,
                     size_t *n_tri, char *msg, size_t msg_len) {
   if (msg != NULL && msg_len > 0)
     msg[0] = '\0';
@@ -1568,7 +1568,7 @@ static int read_any(const char *path, sc_points_t *pts, uint32_t **tri,
   if (n_tri != NULL)
     *n_tri = 0;
   if (path == NULL || pts == NULL || (n_tri != NULL && tri == NULL))
-    return fail(msg, msg_len, SC_FILE_EINVAL, path,
+    return fail(msg, msg_len, SCF_EINVAL, path,
                 "NULL path or output argument");
   enum kind kind = kind_of(path);
   int mesh = n_tri != NULL;
@@ -1622,12 +1622,12 @@ static int read_any(const char *path, sc_points_t *pts, uint32_t **tri,
   return 0;
 }
 
-int sc_points_read(const char *path, sc_points_t *out, char *msg,
+int scf_points_read(const char *path, scf_points_t *out, char *msg,
                    size_t msg_len) {
   return read_any(path, out, NULL, NULL, msg, msg_len);
 }
 
-int sc_mesh_read(const char *path, sc_points_t *pts, uint32_t **tri,
+int scf_mesh_read(const char *path, scf_points_t *pts, uint32_t **tri,
                  size_t *n_tri, char *msg, size_t msg_len) {
   if (n_tri == NULL) {
     /* The outputs that were given are zeroed, as on any failure. */
@@ -1635,12 +1635,12 @@ int sc_mesh_read(const char *path, sc_points_t *pts, uint32_t **tri,
       memset(pts, 0, sizeof *pts);
     if (tri != NULL)
       *tri = NULL;
-    return fail(msg, msg_len, SC_FILE_EINVAL, path, "NULL n_tri argument");
+    return fail(msg, msg_len, SCF_EINVAL, path, "NULL n_tri argument");
   }
   return read_any(path, pts, tri, n_tri, msg, msg_len);
 }
 
-void sc_points_free(sc_points_t *p) {
+void scf_points_free(scf_points_t *p) {
   if (p == NULL)
     return;
   free(p->xyz);
@@ -1680,7 +1680,7 @@ static mode_t current_umask(void) {
 }
 
 static int aout_errno(aout_t *o, const char *what) {
-  return fail(o->msg, o->msg_len, SC_FILE_EIO, o->path, "%s: %s", what,
+  return fail(o->msg, o->msg_len, SCF_EIO, o->path, "%s: %s", what,
               strerror(errno));
 }
 
@@ -1708,7 +1708,7 @@ static int aout_open(aout_t *o, const char *path, char *msg, size_t msg_len) {
   const char *base = slash ? slash + 1 : path;
   size_t dirlen = (size_t)(base - path);
   if (*base == '\0')
-    return fail(msg, msg_len, SC_FILE_EINVAL, path, "not a file name");
+    return fail(msg, msg_len, SCF_EINVAL, path, "not a file name");
   /* The temporary name adds 12 bytes to the target's; a name near the
    * file system's limit (255 bytes) is cut so the temporary one fits. */
   size_t baselen = strlen(base);
@@ -1717,7 +1717,7 @@ static int aout_open(aout_t *o, const char *path, char *msg, size_t msg_len) {
   size_t len = dirlen + baselen + sizeof "..tmp.XXXXXX";
   o->tmp = malloc(len);
   if (o->tmp == NULL)
-    return fail(msg, msg_len, SC_FILE_ENOMEM, path, "out of memory");
+    return fail(msg, msg_len, SCF_ENOMEM, path, "out of memory");
   snprintf(o->tmp, len, "%.*s.%.*s.tmp.XXXXXX", (int)dirlen, path,
            (int)baselen, base);
   o->fd = mkstemp(o->tmp);
@@ -1791,12 +1791,12 @@ static int out_printf(aout_t *o, const char *fmt, ...) {
   return n < 0 ? aout_errno(o, "write failed") : 0;
 }
 
-int sc_file_write_atomic(const char *path, const void *data, size_t len,
+int scf_write_atomic(const char *path, const void *data, size_t len,
                          char *msg, size_t msg_len) {
   if (msg != NULL && msg_len > 0)
     msg[0] = '\0';
   if (path == NULL || (data == NULL && len > 0))
-    return fail(msg, msg_len, SC_FILE_EINVAL, path, "NULL argument");
+    return fail(msg, msg_len, SCF_EINVAL, path, "NULL argument");
   aout_t o;
   int rc = aout_open(&o, path, msg, msg_len);
   if (rc == 0 && (rc = out_write(&o, data, len)) == 0)
@@ -1806,23 +1806,23 @@ int sc_file_write_atomic(const char *path, const void *data, size_t len,
   return rc;
 }
 
-int sc_mesh_format_from_path(const char *path, int ascii,
-                             sc_mesh_format_t *fmt, char *msg,
+int scf_mesh_format_from_path(const char *path, int ascii,
+                             scf_mesh_format_t *fmt, char *msg,
                              size_t msg_len) {
   if (path == NULL || fmt == NULL)
-    return fail(msg, msg_len, SC_FILE_EINVAL, path, "NULL argument");
+    return fail(msg, msg_len, SCF_EINVAL, path, "NULL argument");
   switch (kind_of(path)) {
   case K_PLY:
-    *fmt = ascii ? SC_MESH_FMT_PLY_ASCII : SC_MESH_FMT_PLY_BINARY;
+    *fmt = ascii ? SCF_MESH_FMT_PLY_ASCII : SCF_MESH_FMT_PLY_BINARY;
     return 0;
   case K_OFF:
-    *fmt = SC_MESH_FMT_OFF;
+    *fmt = SCF_MESH_FMT_OFF;
     return 0;
   case K_OBJ:
-    *fmt = SC_MESH_FMT_OBJ;
+    *fmt = SCF_MESH_FMT_OBJ;
     return 0;
   case K_STL:
-    *fmt = ascii ? SC_MESH_FMT_STL_ASCII : SC_MESH_FMT_STL_BINARY;
+    *fmt = ascii ? SCF_MESH_FMT_STL_ASCII : SCF_MESH_FMT_STL_BINARY;
     return 0;
   default:
     return unknown_extension(path, msg, msg_len, ".ply, .off, .obj or .stl");
@@ -1998,31 +1998,31 @@ static int write_stl(aout_t *o, const mesh_in_t *m, int ascii) {
   return rc;
 }
 
-int sc_mesh_write(const char *path, sc_mesh_format_t fmt, const double *xyz,
+int scf_mesh_write(const char *path, scf_mesh_format_t fmt, const double *xyz,
                   size_t n_points, const uint32_t *tri, size_t n_tri,
                   const double *normals, char *msg, size_t msg_len) {
   if (msg != NULL && msg_len > 0)
     msg[0] = '\0';
   if (path == NULL || (xyz == NULL && n_points > 0) ||
       (tri == NULL && n_tri > 0))
-    return fail(msg, msg_len, SC_FILE_EINVAL, path,
+    return fail(msg, msg_len, SCF_EINVAL, path,
                 "NULL path, points or triangles");
-  if (fmt == SC_MESH_FMT_AUTO) {
-    int rc = sc_mesh_format_from_path(path, 0, &fmt, msg, msg_len);
+  if (fmt == SCF_MESH_FMT_AUTO) {
+    int rc = scf_mesh_format_from_path(path, 0, &fmt, msg, msg_len);
     if (rc < 0)
       return rc;
   }
-  if (fmt < SC_MESH_FMT_PLY_BINARY || fmt > SC_MESH_FMT_STL_ASCII)
-    return fail(msg, msg_len, SC_FILE_EINVAL, path, "unknown format %d",
+  if (fmt < SCF_MESH_FMT_PLY_BINARY || fmt > SCF_MESH_FMT_STL_ASCII)
+    return fail(msg, msg_len, SCF_EINVAL, path, "unknown format %d",
                 (int)fmt);
   for (size_t i = 0; i < 3 * n_tri; i++)
     if (tri[i] >= n_points)
-      return fail(msg, msg_len, SC_FILE_EINVAL, path,
+      return fail(msg, msg_len, SCF_EINVAL, path,
                   "triangle %zu refers to point %u, but there are %zu "
                   "points",
                   i / 3, (unsigned)tri[i], n_points);
-  if (fmt == SC_MESH_FMT_STL_BINARY && n_tri > UINT32_MAX)
-    return fail(msg, msg_len, SC_FILE_EUNSUPPORTED, path,
+  if (fmt == SCF_MESH_FMT_STL_BINARY && n_tri > UINT32_MAX)
+    return fail(msg, msg_len, SCF_EUNSUPPORTED, path,
                 "binary STL holds at most 2^32 - 1 triangles, not %zu",
                 n_tri);
   mesh_in_t m = {xyz, n_points, tri, n_tri, normals};
@@ -2031,18 +2031,18 @@ int sc_mesh_write(const char *path, sc_mesh_format_t fmt, const double *xyz,
   if (rc < 0)
     return rc;
   switch (fmt) {
-  case SC_MESH_FMT_PLY_BINARY:
-  case SC_MESH_FMT_PLY_ASCII:
-    rc = write_ply(&o, &m, fmt == SC_MESH_FMT_PLY_ASCII);
+  case SCF_MESH_FMT_PLY_BINARY:
+  case SCF_MESH_FMT_PLY_ASCII:
+    rc = write_ply(&o, &m, fmt == SCF_MESH_FMT_PLY_ASCII);
     break;
-  case SC_MESH_FMT_OFF:
+  case SCF_MESH_FMT_OFF:
     rc = write_off(&o, &m);
     break;
-  case SC_MESH_FMT_OBJ:
+  case SCF_MESH_FMT_OBJ:
     rc = write_obj(&o, &m);
     break;
   default:
-    rc = write_stl(&o, &m, fmt == SC_MESH_FMT_STL_ASCII);
+    rc = write_stl(&o, &m, fmt == SCF_MESH_FMT_STL_ASCII);
     break;
   }
   if (rc == 0)

@@ -12,8 +12,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "files.h"
 #include "shortcrust.h"
+#include "shortcrust_files.h"
 #include "testsupport.h"
 
 int main(int argc, char **argv) {
@@ -35,8 +35,8 @@ int main(int argc, char **argv) {
   }
   int genus = atoi(argv[2]);
   char msg[512];
-  sc_points_t pts;
-  if (sc_points_read(argv[1], &pts, msg, sizeof msg) != 0) {
+  scf_points_t pts;
+  if (scf_points_read(argv[1], &pts, msg, sizeof msg) != 0) {
     fprintf(stderr, "FAIL: %s\n", msg);
     return 1;
   }
@@ -68,6 +68,6 @@ int main(int argc, char **argv) {
   CHECK_DIAG_COUNTS(m->diag, c);
   sc_meshcheck_free(&c);
   sc_mesh_free(m);
-  sc_points_free(&pts);
+  scf_points_free(&pts);
   return CHECK_DONE();
 }
