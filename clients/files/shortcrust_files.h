@@ -2,7 +2,8 @@
  * Point and mesh files: the one place that reads and writes PLY, XYZ-like
  * text, OFF, OBJ and STL, shared by the local command and the client. The
  * module's public names start with scf_ (SCF_ for constants), to keep them
- * apart from the core's sc_ names.
+ * apart from the core's sc_ names; the internals shared between its source
+ * files (scf_internal.h) start with scf__.
  *
  * Readers stream the file through a fixed buffer, so a file is never held in
  * memory whole, and they check every count a header declares against the
