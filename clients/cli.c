@@ -16,7 +16,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "files.h"
+#include "shortcrust_files.h"
 
 void sc_cli_error(const char *fmt, ...) {
   va_list ap;
@@ -247,11 +247,11 @@ char *sc_cli_report_json(const sc_cli_result_t *r) {
     return NULL;
   const sc_diag_t *d = r->diag;
   fputs("{\n  \"command\": ", f);
-  sc_file_json_string(f, r->command);
+  scf_json_string(f, r->command);
   fputs(",\n  \"input\": ", f);
-  sc_file_json_string(f, r->input);
+  scf_json_string(f, r->input);
   fputs(",\n  \"output\": ", f);
-  sc_file_json_string(f, r->output);
+  scf_json_string(f, r->output);
   fputs(",\n", f);
   sc_cli_report_params(f, &r->params);
   sc_cli_report_diag(f, d);
@@ -280,7 +280,7 @@ int sc_cli_write_report(const char *path, const sc_cli_result_t *r) {
     return -1;
   }
   char msg[512];
-  int rc = sc_file_write_atomic(path, json, strlen(json), msg, sizeof msg);
+  int rc = scf_write_atomic(path, json, strlen(json), msg, sizeof msg);
   free(json);
   if (rc < 0) {
     sc_cli_error("%s", msg);
@@ -290,10 +290,10 @@ int sc_cli_write_report(const char *path, const sc_cli_result_t *r) {
 }
 
 int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
-                    sc_mesh_format_t *fmt, sc_points_t *pts,
+                    scf_mesh_format_t *fmt, scf_points_t *pts,
                     double *seconds_read) {
   char msg[1024];
-  if (sc_mesh_format_from_path(o->out_path, o->ascii, fmt, msg, sizeof msg) <
+  if (scf_mesh_format_from_path(o->out_path, o->ascii, fmt, msg, sizeof msg) <
       0) {
     sc_cli_error("%s", msg);
     return SC_EXIT_USAGE;
@@ -301,7 +301,7 @@ int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
   sc_cli_progress_init(progress, o->quiet);
   double t0 = sc_cli_now();
   sc_cli_progress_step(progress, "reading", 0);
-  if (sc_points_read(o->in_path, pts, msg, sizeof msg) < 0) {
+  if (scf_points_read(o->in_path, pts, msg, sizeof msg) < 0) {
     sc_cli_progress_done(progress);
     sc_cli_error("%s", msg);
     return SC_EXIT_FAILURE;
@@ -311,13 +311,13 @@ int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
 }
 
 int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
-                     sc_mesh_format_t fmt, const sc_points_t *pts,
+                     scf_mesh_format_t fmt, const scf_points_t *pts,
                      const uint32_t *tris, size_t ntri,
                      const double *normals, sc_cli_result_t *r) {
   char msg[1024];
   sc_cli_progress_step(progress, "writing", 0);
   double t0 = sc_cli_now();
-  int rc = sc_mesh_write(o->out_path, fmt, pts->xyz, pts->count, tris, ntri,
+  int rc = scf_mesh_write(o->out_path, fmt, pts->xyz, pts->count, tris, ntri,
                          o->normals ? normals : NULL, msg, sizeof msg);
   r->seconds_write = sc_cli_now() - t0;
   sc_cli_progress_done(progress);

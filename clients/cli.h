@@ -16,8 +16,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "files.h"
 #include "shortcrust.h"
+#include "shortcrust_files.h"
 
 /* Exit codes of every subcommand. */
 enum {
@@ -150,11 +150,11 @@ int sc_cli_write_report(const char *path, const sc_cli_result_t *r);
  * report and prints the summary; it returns the exit status.
  */
 int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
-                    sc_mesh_format_t *fmt, sc_points_t *pts,
+                    scf_mesh_format_t *fmt, scf_points_t *pts,
                     double *seconds_read);
 int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
-                     sc_mesh_format_t fmt, const sc_points_t *pts,
-                     const uint32_t *tris, size_t ntri,
-                     const double *normals, sc_cli_result_t *r);
+                     scf_mesh_format_t fmt, const scf_points_t *pts,
+                     const uint32_t *tris, size_t ntri, const double *normals,
+                     sc_cli_result_t *r);
 
 #endif /* SC_CLI_H */

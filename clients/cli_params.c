@@ -252,7 +252,7 @@ void sc_cli_report_params(FILE *f, const sc_params_t *p) {
     sep = ", ";
     switch (rows[i].kind) {
     case SC_PARAM_MODE:
-      sc_file_json_string(f, sc_mode_name(*(const int *)field));
+      scf_json_string(f, sc_mode_name(*(const int *)field));
       break;
     case SC_PARAM_INT:
     case SC_PARAM_FLAG:
@@ -277,7 +277,7 @@ static void report_row(FILE *f, const sc_diag_info_t *row, const void *v) {
     break;
   case SC_DIAG_PATH:
     fprintf(f, "  \"%s\": ", row->name);
-    sc_file_json_string(f, sc_path_name(*(const int *)v));
+    scf_json_string(f, sc_path_name(*(const int *)v));
     fputs(",\n", f);
     break;
   case SC_DIAG_LOOPS:

@@ -13,7 +13,7 @@
 
 #include "cli.h"
 #include "cli_commands.h"
-#include "files.h"
+#include "shortcrust_files.h"
 
 static void usage(FILE *f) {
   fputs("usage: shortcrust reconstruct IN -o OUT [options]\n\n"
@@ -69,8 +69,8 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   const char *in_path = o.in_path, *out_path = o.out_path;
 
   sc_cli_progress_t progress;
-  sc_mesh_format_t fmt;
-  sc_points_t pts;
+  scf_mesh_format_t fmt;
+  scf_points_t pts;
   double t_read;
   /* A hint, before the first large allocation; see shortcrust.h. */
   (void)sc_tune_allocator();
@@ -85,7 +85,7 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   int rc = sc_reconstruct(pts.xyz, pts.count, params, &mesh, msg, sizeof msg);
   if (rc < 0) {
     sc_cli_progress_done(&progress);
-    sc_points_free(&pts);
+    scf_points_free(&pts);
     /* A parameter out of range is the command line's fault, not the file's. */
     if (rc == SC_EINVALID_ARGUMENT) {
       sc_cli_error("reconstruct: %s", msg);
@@ -108,6 +108,6 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   status = sc_cli_job_write(&o, &progress, fmt, &pts, mesh->triangles,
                             mesh->triangle_count, mesh->normals, &res);
   sc_mesh_free(mesh);
-  sc_points_free(&pts);
+  scf_points_free(&pts);
   return status;
 }

@@ -15,8 +15,8 @@
 
 #include "cli.h"
 #include "cli_commands.h"
-#include "files.h"
 #include "shortcrust_client.h"
+#include "shortcrust_files.h"
 
 static void usage(FILE *f) {
   char sock[256];
@@ -172,8 +172,8 @@ int sc_cmd_submit(int argc, char **argv) {
   const char *in_path = o.in_path, *out_path = o.out_path;
 
   sc_cli_progress_t progress;
-  sc_mesh_format_t fmt;
-  sc_points_t pts;
+  scf_mesh_format_t fmt;
+  scf_points_t pts;
   double t_read;
   int status = sc_cli_job_read(&o, &progress, &fmt, &pts, &t_read);
   if (status != SC_EXIT_OK)
@@ -187,7 +187,7 @@ int sc_cmd_submit(int argc, char **argv) {
   int rc = sc_client_connect(&opts, &client, msg, sizeof msg);
   if (rc < 0) {
     sc_cli_progress_done(&progress);
-    sc_points_free(&pts);
+    scf_points_free(&pts);
     sc_cli_error("%s", msg);
     return SC_EXIT_FAILURE;
   }
@@ -235,7 +235,7 @@ int sc_cmd_submit(int argc, char **argv) {
     }
     sc_client_job_free(job);
     sc_client_free(client);
-    sc_points_free(&pts);
+    scf_points_free(&pts);
     return status;
   }
 
@@ -259,6 +259,6 @@ int sc_cmd_submit(int argc, char **argv) {
                             (size_t)mesh.triangle_count, mesh.normals, &res);
   sc_client_job_free(job);
   sc_client_free(client);
-  sc_points_free(&pts);
+  scf_points_free(&pts);
   return status;
 }

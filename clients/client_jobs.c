@@ -7,7 +7,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "client_internal.h"
-#include "files.h"
+#include "shortcrust_files.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -282,16 +282,16 @@ int sc_client_submit_file(sc_client_t *c, const sc_client_params_t *params,
   int rc = scc_usable(c);
   if (rc < 0)
     return rc;
-  sc_points_t pts;
+  scf_points_t pts;
   char msg[SCC_MSG_MAX];
-  rc = sc_points_read(path, &pts, msg, sizeof msg);
+  rc = scf_points_read(path, &pts, msg, sizeof msg);
   if (rc < 0)
     return scc_fail(c,
-                    rc == SC_FILE_ENOMEM ? SC_CLIENT_ENOMEM : SC_CLIENT_EFILE,
+                    rc == SCF_ENOMEM ? SC_CLIENT_ENOMEM : SC_CLIENT_EFILE,
                     "%s", msg);
   rc = submit(c, params, pts.xyz, pts.count, pts.xyz, job);
   if (rc < 0)
-    sc_points_free(&pts);
+    scf_points_free(&pts);
   return rc;
 }
 

@@ -28,7 +28,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "files.h"
+#include "shortcrust_files.h"
 #include "shortcrust_client.h"
 #include "synth.h"
 
@@ -613,9 +613,9 @@ int main(int argc, char **argv) {
     cfg.inputs = calloc(cfg.ninputs, sizeof *cfg.inputs);
     for (size_t i = 0; cfg.inputs && i < nfiles; i++) {
       input_t *in = &cfg.inputs[i];
-      sc_points_t pts;
+      scf_points_t pts;
       char msg[1024];
-      if (sc_points_read(files[i], &pts, msg, sizeof msg) < 0) {
+      if (scf_points_read(files[i], &pts, msg, sizeof msg) < 0) {
         say("%s", msg);
         return 1;
       }
@@ -768,7 +768,7 @@ int main(int argc, char **argv) {
            (unsigned long long)all.failed);
     for (size_t k = 0; k < all.ncodes; k++) {
       printf("%s", k ? ", " : "");
-      sc_file_json_string(stdout, all.codes[k].name);
+      scf_json_string(stdout, all.codes[k].name);
       printf(": %llu", (unsigned long long)all.codes[k].count);
     }
     printf("}, \"verify\": %s, \"verified\": %llu, \"verify_failures\": %llu, "

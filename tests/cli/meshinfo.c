@@ -10,7 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "files.h"
+#include "shortcrust_files.h"
 #include "synth.h"
 
 int main(int argc, char **argv) {
@@ -18,11 +18,11 @@ int main(int argc, char **argv) {
     fprintf(stderr, "usage: meshinfo FILE\n");
     return 2;
   }
-  sc_points_t pts;
+  scf_points_t pts;
   uint32_t *tri;
   size_t ntri;
   char msg[512];
-  if (sc_mesh_read(argv[1], &pts, &tri, &ntri, msg, sizeof msg) != 0) {
+  if (scf_mesh_read(argv[1], &pts, &tri, &ntri, msg, sizeof msg) != 0) {
     fprintf(stderr, "meshinfo: %s\n", msg);
     return 1;
   }
@@ -43,6 +43,6 @@ int main(int argc, char **argv) {
          (unsigned long long)c.samples_unused, c.volume > 0, all);
   scs_meshcheck_free(&c);
   free(tri);
-  sc_points_free(&pts);
+  scf_points_free(&pts);
   return 0;
 }

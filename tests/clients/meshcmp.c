@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "files.h"
+#include "shortcrust_files.h"
 
 /* Rotates a triangle so that its smallest index comes first, which keeps
  * its orientation. */
@@ -39,12 +39,12 @@ int main(int argc, char **argv) {
     fprintf(stderr, "usage: meshcmp A B\n");
     return 2;
   }
-  sc_points_t p[2];
+  scf_points_t p[2];
   uint32_t *t[2];
   size_t nt[2];
   char msg[1024];
   for (int i = 0; i < 2; i++) {
-    if (sc_mesh_read(argv[1 + i], &p[i], &t[i], &nt[i], msg, sizeof msg)) {
+    if (scf_mesh_read(argv[1 + i], &p[i], &t[i], &nt[i], msg, sizeof msg)) {
       fprintf(stderr, "meshcmp: %s\n", msg);
       return 2;
     }
@@ -80,7 +80,7 @@ int main(int argc, char **argv) {
   }
   printf("same: %zu vertices, %zu triangles\n", p[0].count, nt[0]);
   for (int i = 0; i < 2; i++) {
-    sc_points_free(&p[i]);
+    scf_points_free(&p[i]);
     free(t[i]);
   }
   return 0;

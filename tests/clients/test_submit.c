@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "common.h"
-#include "files.h"
+#include "shortcrust_files.h"
 
 static scdt_daemon_t d;
 static const char *datadir;
@@ -73,9 +73,9 @@ static void from_file(void) {
   sc_client_t *c = scct_open(d.sock, 0);
   char path[512];
   snprintf(path, sizeof path, "%s/knot1_points.ply", datadir);
-  sc_points_t pts;
+  scf_points_t pts;
   char msg[512];
-  ASSERT_MSG(sc_points_read(path, &pts, msg, sizeof msg) == 0, "%s", msg);
+  ASSERT_MSG(scf_points_read(path, &pts, msg, sizeof msg) == 0, "%s", msg);
   sc_client_job_t *j = NULL;
   int rc = sc_client_submit_file(c, NULL, path, &j);
   ASSERT_MSG(rc == 0, "submit_file: %s", sc_client_last_error(c));
@@ -127,7 +127,7 @@ static void from_file(void) {
              "message '%s' does not name the file", sc_client_last_error(c));
   /* The connection is still fine. */
   EXPECT_EQ(sc_client_ping(c, SCCT_WAIT_MS, NULL), 0);
-  sc_points_free(&pts);
+  scf_points_free(&pts);
   sc_client_free(c);
 }
 

@@ -40,7 +40,7 @@
 #include <malloc.h>
 #endif
 
-#include "files.h"
+#include "shortcrust_files.h"
 #include "shortcrust.h"
 #include "synth.h"
 
@@ -176,9 +176,9 @@ int measure(const std::string &dir, const std::string &name, int repeat,
   const char *const mode_names[] = {"cocone", "boundary", "watertight",
                                     "auto"};
   char msg[512];
-  sc_points_t pts;
+  scf_points_t pts;
   std::string path = dir + "/" + name + ".ply";
-  if (sc_points_read(path.c_str(), &pts, msg, sizeof msg) != 0) {
+  if (scf_points_read(path.c_str(), &pts, msg, sizeof msg) != 0) {
     std::fprintf(stderr, "%s\n", msg);
     return 1;
   }
@@ -233,11 +233,11 @@ int measure(const std::string &dir, const std::string &name, int repeat,
                    : name.rfind("cgal_kitten", 0) == 0 ? "kitten_gt_mesh"
                                                         : "";
   if (!gt.empty()) {
-    sc_points_t gp;
+    scf_points_t gp;
     uint32_t *gt_tri = nullptr;
     size_t gnt = 0;
     std::string gpath = dir + "/" + gt + ".ply";
-    if (sc_mesh_read(gpath.c_str(), &gp, &gt_tri, &gnt, msg, sizeof msg) ==
+    if (scf_mesh_read(gpath.c_str(), &gp, &gt_tri, &gnt, msg, sizeof msg) ==
         0) {
       ref = std::make_unique<Reference>();
       for (size_t i = 0; i < gnt; ++i) {
@@ -251,7 +251,7 @@ int measure(const std::string &dir, const std::string &name, int repeat,
       ref->tree = std::make_unique<Tree>(ref->tris.begin(), ref->tris.end());
       ref->tree->accelerate_distance_queries();
       std::free(gt_tri);
-      sc_points_free(&gp);
+      scf_points_free(&gp);
     } else {
       std::fprintf(stderr, "%s (no distances)\n", msg);
     }
@@ -271,7 +271,7 @@ int measure(const std::string &dir, const std::string &name, int repeat,
   }
 
   if (!afsr) {
-    sc_points_free(&pts);
+    scf_points_free(&pts);
     return 0;
   }
   // CGAL's advancing-front reconstruction with its defaults.
@@ -287,7 +287,7 @@ int measure(const std::string &dir, const std::string &name, int repeat,
       t.push_back(uint32_t(f[k]));
   row(name.c_str(), "CGAL AFSR", "-", pts.count, t.data(), facets.size(),
       pts.xyz, ref.get(), spacing, sec, dt_seconds);
-  sc_points_free(&pts);
+  scf_points_free(&pts);
   return 0;
 }
 

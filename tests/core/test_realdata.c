@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "diag.h"
-#include "files.h"
+#include "shortcrust_files.h"
 #include "shortcrust.h"
 #include "synth.h"
 
@@ -36,8 +36,8 @@ int main(int argc, char **argv) {
   }
   int genus = atoi(argv[2]);
   char msg[512];
-  sc_points_t pts;
-  if (sc_points_read(argv[1], &pts, msg, sizeof msg) != 0) {
+  scf_points_t pts;
+  if (scf_points_read(argv[1], &pts, msg, sizeof msg) != 0) {
     fprintf(stderr, "FAIL: %s\n", msg);
     return 1;
   }
@@ -69,6 +69,6 @@ int main(int argc, char **argv) {
   EXPECT_DIAG_COUNTS(m->diag, c);
   scs_meshcheck_free(&c);
   sc_mesh_free(m);
-  sc_points_free(&pts);
+  scf_points_free(&pts);
   return sct_finish("core_realdata");
 }

@@ -9,7 +9,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "check.h"
-#include "files.h"
+#include "shortcrust_files.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -19,9 +19,9 @@ enum { N = 5000, NT = 4000 };
 static double xyz[3 * N];
 static uint32_t tri[3 * NT];
 
-static const sc_mesh_format_t formats[] = {
-    SC_MESH_FMT_PLY_BINARY, SC_MESH_FMT_PLY_ASCII,  SC_MESH_FMT_OFF,
-    SC_MESH_FMT_OBJ,        SC_MESH_FMT_STL_BINARY, SC_MESH_FMT_STL_ASCII};
+static const scf_mesh_format_t formats[] = {
+    SCF_MESH_FMT_PLY_BINARY, SCF_MESH_FMT_PLY_ASCII,  SCF_MESH_FMT_OFF,
+    SCF_MESH_FMT_OBJ,        SCF_MESH_FMT_STL_BINARY, SCF_MESH_FMT_STL_ASCII};
 
 static void make_mesh(void) {
   for (int i = 0; i < 3 * N; i++)
@@ -61,18 +61,18 @@ static void test_modes(void) {
   char msg[256];
   mode_t old = umask(027);
   const char *path = tmp_path("new.ply");
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_AUTO, xyz, N, tri, NT, NULL, msg,
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL, msg,
                              sizeof msg),
                0);
   CHECK_INT_EQ(mode_of(path), 0640);
   umask(022);
   CHECK_INT_EQ(
-      sc_file_write_atomic(tmp_path("new.txt"), "x", 1, msg, sizeof msg), 0);
+      scf_write_atomic(tmp_path("new.txt"), "x", 1, msg, sizeof msg), 0);
   CHECK_INT_EQ(mode_of(tmp_path("new.txt")), 0644);
 
   /* Replacing keeps an unusual mode, whatever the umask says. */
   CHECK(chmod(path, 0604) == 0);
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_OFF, xyz, 3, tri, 1, NULL, msg,
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_OFF, xyz, 3, tri, 1, NULL, msg,
                              sizeof msg),
                0);
   CHECK_INT_EQ(mode_of(path), 0604);
@@ -92,12 +92,12 @@ static void test_replace(void) {
   char msg[256];
   const char *path = tmp_path("replace.txt");
   CHECK_INT_EQ(
-      sc_file_write_atomic(path, "first version\n", 14, msg, sizeof msg), 0);
+      scf_write_atomic(path, "first version\n", 14, msg, sizeof msg), 0);
   int fd = open(path, O_RDONLY);
   CHECK(fd >= 0);
   struct stat before, after;
   CHECK(fstat(fd, &before) == 0);
-  CHECK_INT_EQ(sc_file_write_atomic(path, "second\n", 7, msg, sizeof msg), 0);
+  CHECK_INT_EQ(scf_write_atomic(path, "second\n", 7, msg, sizeof msg), 0);
   CHECK(stat(path, &after) == 0);
   CHECK(before.st_ino != after.st_ino);
   char buf[32] = {0};
@@ -109,14 +109,14 @@ static void test_replace(void) {
   free(s);
 
   /* Empty data gives an empty file; data NULL with a length is refused. */
-  CHECK_INT_EQ(sc_file_write_atomic(path, NULL, 0, msg, sizeof msg), 0);
+  CHECK_INT_EQ(scf_write_atomic(path, NULL, 0, msg, sizeof msg), 0);
   CHECK_U64_EQ(after.st_size, 7);
   CHECK(stat(path, &after) == 0);
   CHECK_U64_EQ(after.st_size, 0);
-  CHECK_INT_EQ(sc_file_write_atomic(path, NULL, 1, msg, sizeof msg),
-               SC_FILE_EINVAL);
-  CHECK_INT_EQ(sc_file_write_atomic(NULL, "x", 1, msg, sizeof msg),
-               SC_FILE_EINVAL);
+  CHECK_INT_EQ(scf_write_atomic(path, NULL, 1, msg, sizeof msg),
+               SCF_EINVAL);
+  CHECK_INT_EQ(scf_write_atomic(NULL, "x", 1, msg, sizeof msg),
+               SCF_EINVAL);
   CHECK_INT_EQ(temporaries(), 0);
 
   /* A name near the file system's limit still gets a temporary file. */
@@ -124,7 +124,7 @@ static void test_replace(void) {
   memset(name, 'n', 250);
   memcpy(name + 250, ".obj", 5);
   path = tmp_path(name);
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_AUTO, xyz, 3, tri, 1, NULL, msg,
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, 3, tri, 1, NULL, msg,
                              sizeof msg),
                0);
   s = read_all(path, NULL);
@@ -152,9 +152,9 @@ static void test_failed_write(void) {
     CHECK(stat(path, &before) == 0);
     limit_file_size(4096);
     int rc =
-        sc_mesh_write(path, formats[f], xyz, N, tri, NT, NULL, msg, sizeof msg);
+        scf_mesh_write(path, formats[f], xyz, N, tri, NT, NULL, msg, sizeof msg);
     unlimit_file_size();
-    CHECK_INT_EQ(rc, SC_FILE_EIO);
+    CHECK_INT_EQ(rc, SCF_EIO);
     CHECK_CONTAINS(msg, path);
     CHECK_CONTAINS(msg, "failed");
     char *s = read_all(path, NULL);
@@ -175,13 +175,13 @@ static void test_failed_write(void) {
   write_text(path, old_text);
   char msg[256];
   limit_file_size(4096);
-  int rc = sc_file_write_atomic(path, data, len, msg, sizeof msg);
+  int rc = scf_write_atomic(path, data, len, msg, sizeof msg);
   int rc_new =
-      sc_file_write_atomic(tmp_path("never.txt"), data, len, msg, sizeof msg);
+      scf_write_atomic(tmp_path("never.txt"), data, len, msg, sizeof msg);
   unlimit_file_size();
   free(data);
-  CHECK_INT_EQ(rc, SC_FILE_EIO);
-  CHECK_INT_EQ(rc_new, SC_FILE_EIO);
+  CHECK_INT_EQ(rc, SCF_EIO);
+  CHECK_INT_EQ(rc_new, SCF_EIO);
   char *s = read_all(path, NULL);
   CHECK_STR_EQ(s, old_text);
   free(s);
@@ -197,9 +197,9 @@ static void test_failed_rename(void) {
   const char *dir = tmp_path("taken.ply");
   CHECK(mkdir(dir, 0700) == 0);
   CHECK(mkdir(tmp_path("taken.ply/inside"), 0700) == 0);
-  CHECK_INT_EQ(sc_mesh_write(dir, SC_MESH_FMT_AUTO, xyz, N, tri, NT, NULL, msg,
+  CHECK_INT_EQ(scf_mesh_write(dir, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL, msg,
                              sizeof msg),
-               SC_FILE_EIO);
+               SCF_EIO);
   CHECK_CONTAINS(msg, dir);
   CHECK_CONTAINS(msg, "rename");
   struct stat st;
@@ -208,13 +208,13 @@ static void test_failed_rename(void) {
 
   /* No directory to put it in. */
   const char *path = tmp_path("nowhere/out.ply");
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_AUTO, xyz, 3, tri, 1, NULL, msg,
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, 3, tri, 1, NULL, msg,
                              sizeof msg),
-               SC_FILE_EIO);
+               SCF_EIO);
   CHECK_CONTAINS(msg, "cannot create a temporary file");
   CHECK(stat(tmp_path("nowhere"), &st) != 0);
-  CHECK_INT_EQ(sc_file_write_atomic(path, "x", 1, msg, sizeof msg),
-               SC_FILE_EIO);
+  CHECK_INT_EQ(scf_write_atomic(path, "x", 1, msg, sizeof msg),
+               SCF_EIO);
   CHECK_INT_EQ(temporaries(), 0);
 }
 

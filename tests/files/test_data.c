@@ -9,7 +9,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "check.h"
-#include "files.h"
+#include "shortcrust_files.h"
 
 #include <math.h>
 
@@ -45,7 +45,7 @@ static int cmp_point(const void *a, const void *b) {
   return 0;
 }
 
-static void check_same(const sc_points_t *a, const sc_points_t *b) {
+static void check_same(const scf_points_t *a, const scf_points_t *b) {
   CHECK_U64_EQ(a->count, b->count);
   for (size_t i = 0; i < 3 * a->count; i++)
     CHECK_DBL_SAME(a->xyz[i], b->xyz[i]);
@@ -54,8 +54,8 @@ static void check_same(const sc_points_t *a, const sc_points_t *b) {
 static void check_file(const char *dir, const expected_t *e) {
   char path[1024], msg[512];
   snprintf(path, sizeof path, "%s/%s", dir, e->name);
-  sc_points_t p;
-  int rc = sc_points_read(path, &p, msg, sizeof msg);
+  scf_points_t p;
+  int rc = scf_points_read(path, &p, msg, sizeof msg);
   if (rc != 0)
     CHECK_FAIL_("%s", msg);
   CHECK_U64_EQ(p.count, e->count);
@@ -90,29 +90,29 @@ static void check_file(const char *dir, const expected_t *e) {
   free(sorted);
 
   /* As a mesh: the same points, no faces. */
-  sc_points_t m;
+  scf_points_t m;
   uint32_t *tri;
   size_t nt;
-  CHECK_INT_EQ(sc_mesh_read(path, &m, &tri, &nt, msg, sizeof msg), 0);
+  CHECK_INT_EQ(scf_mesh_read(path, &m, &tri, &nt, msg, sizeof msg), 0);
   check_same(&p, &m);
   CHECK_U64_EQ(nt, 0);
-  sc_points_free(&m);
+  scf_points_free(&m);
 
   /* Written and read back, in binary and in ascii. */
-  static const sc_mesh_format_t fmts[] = {SC_MESH_FMT_PLY_BINARY,
-                                          SC_MESH_FMT_PLY_ASCII};
+  static const scf_mesh_format_t fmts[] = {SCF_MESH_FMT_PLY_BINARY,
+                                          SCF_MESH_FMT_PLY_ASCII};
   for (int f = 0; f < 2; f++) {
     const char *copy = tmp_path("copy.ply");
-    CHECK_INT_EQ(sc_mesh_write(copy, fmts[f], p.xyz, p.count, NULL, 0, NULL,
+    CHECK_INT_EQ(scf_mesh_write(copy, fmts[f], p.xyz, p.count, NULL, 0, NULL,
                                msg, sizeof msg),
                  0);
-    CHECK_INT_EQ(sc_points_read(copy, &m, msg, sizeof msg), 0);
+    CHECK_INT_EQ(scf_points_read(copy, &m, msg, sizeof msg), 0);
     check_same(&p, &m);
-    sc_points_free(&m);
+    scf_points_free(&m);
   }
   printf("%s: %zu points, box [%.9g %.9g %.9g] - [%.9g %.9g %.9g]\n", e->name,
          p.count, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 int main(int argc, char **argv) {

@@ -8,7 +8,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "check.h"
-#include "files.h"
+#include "shortcrust_files.h"
 #include "plybuf.h"
 
 /* Reads path as points (mesh 0) or as a mesh and expects code rc with a
@@ -16,15 +16,15 @@
 static void expect_fail(const char *path, int mesh, int rc, const char *frag1,
                         const char *frag2) {
   char msg[512];
-  sc_points_t p;
+  scf_points_t p;
   uint32_t *tri = (uint32_t *)msg;
   size_t nt = 5;
   memset(msg, 'x', sizeof msg);
-  int got = mesh ? sc_mesh_read(path, &p, &tri, &nt, msg, sizeof msg)
-                 : sc_points_read(path, &p, msg, sizeof msg);
+  int got = mesh ? scf_mesh_read(path, &p, &tri, &nt, msg, sizeof msg)
+                 : scf_points_read(path, &p, msg, sizeof msg);
   if (got != rc)
-    CHECK_FAIL_("reading %s: %s (%s), expected %s", path, sc_file_err_name(got),
-                got ? msg : "", sc_file_err_name(rc));
+    CHECK_FAIL_("reading %s: %s (%s), expected %s", path, scf_err_name(got),
+                got ? msg : "", scf_err_name(rc));
   CHECK(p.xyz == NULL);
   CHECK_U64_EQ(p.count, 0);
   if (mesh) {
@@ -54,66 +54,66 @@ typedef struct bad_case {
 #define V3 "0.0 0.0 0.0\n1.0 0.0 0.0\n0.0 1.0 0.0\n"
 
 static const bad_case_t bad_headers[] = {
-    {"empty.ply", "", 0, SC_FILE_EFORMAT, "line 1: ", "not a PLY file"},
-    {"upper.ply", "PLY\nformat ascii 1.0\n", 0, SC_FILE_EFORMAT,
+    {"empty.ply", "", 0, SCF_EFORMAT, "line 1: ", "not a PLY file"},
+    {"upper.ply", "PLY\nformat ascii 1.0\n", 0, SCF_EFORMAT,
      "line 1: ", "first line is not 'ply'"},
     {"noformat.ply", "ply\nelement vertex 0\n" VX "end_header\n", 0,
-     SC_FILE_EFORMAT, "line 6: ", "no format line"},
-    {"badformat.ply", "ply\nformat binary 1.0\n", 0, SC_FILE_EFORMAT,
+     SCF_EFORMAT, "line 6: ", "no format line"},
+    {"badformat.ply", "ply\nformat binary 1.0\n", 0, SCF_EFORMAT,
      "line 2: ", "unknown PLY format 'binary'"},
-    {"version.ply", "ply\nformat ascii 2.0\n", 0, SC_FILE_EUNSUPPORTED,
+    {"version.ply", "ply\nformat ascii 2.0\n", 0, SCF_EUNSUPPORTED,
      "line 2: ", "version '2.0'"},
-    {"shortformat.ply", "ply\nformat ascii\n", 0, SC_FILE_EFORMAT,
+    {"shortformat.ply", "ply\nformat ascii\n", 0, SCF_EFORMAT,
      "line 2: ", "expected 'format <type> 1.0'"},
     {"twoformats.ply", "ply\nformat ascii 1.0\nformat ascii 1.0\n", 0,
-     SC_FILE_EFORMAT, "line 3: ", "second format line"},
+     SCF_EFORMAT, "line 3: ", "second format line"},
     {"nocount.ply", "ply\nformat ascii 1.0\nelement vertex\n", 0,
-     SC_FILE_EFORMAT, "line 3: ", "expected 'element <name> <count>'"},
+     SCF_EFORMAT, "line 3: ", "expected 'element <name> <count>'"},
     {"negcount.ply", "ply\nformat ascii 1.0\nelement vertex -1\n", 0,
-     SC_FILE_EFORMAT, "line 3: ", "expected a count for element 'vertex'"},
+     SCF_EFORMAT, "line 3: ", "expected a count for element 'vertex'"},
     {"hugecount.ply",
      "ply\nformat ascii 1.0\nelement vertex 99999999999999999999\n", 0,
-     SC_FILE_EFORMAT, "line 3: ", "got '99999999999999999999'"},
+     SCF_EFORMAT, "line 3: ", "got '99999999999999999999'"},
     {"early.ply", "ply\nformat ascii 1.0\nproperty float x\n", 0,
-     SC_FILE_EFORMAT, "line 3: ", "property before any element"},
+     SCF_EFORMAT, "line 3: ", "property before any element"},
     {"type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty real x\n",
-     0, SC_FILE_EFORMAT, "line 4: ", "unknown property type 'real'"},
+     0, SCF_EFORMAT, "line 4: ", "unknown property type 'real'"},
     {"listcount.ply",
      "ply\nformat ascii 1.0\nelement face 1\n"
      "property list float int vertex_indices\n",
-     0, SC_FILE_EFORMAT, "line 4: ", "count type 'float' is not an integer"},
+     0, SCF_EFORMAT, "line 4: ", "count type 'float' is not an integer"},
     {"listname.ply",
      "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int\n", 0,
-     SC_FILE_EFORMAT, "line 4: ", "expected 'property <type> <name>'"},
+     SCF_EFORMAT, "line 4: ", "expected 'property <type> <name>'"},
     {"keyword.ply", "ply\nformat ascii 1.0\ncomment fine\nelements vertex 1\n",
-     0, SC_FILE_EFORMAT, "line 4: ", "unknown header keyword 'elements'"},
+     0, SCF_EFORMAT, "line 4: ", "unknown header keyword 'elements'"},
     {"noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\n" VX, 0,
-     SC_FILE_EFORMAT, "line 6: ", "file ends inside the header"},
+     SCF_EFORMAT, "line 6: ", "file ends inside the header"},
     {"novertex.ply",
      "ply\nformat ascii 1.0\nelement point 1\n" VX "end_header\n1 2 3\n", 0,
-     SC_FILE_EFORMAT, "line 7: ", "no vertex element"},
+     SCF_EFORMAT, "line 7: ", "no vertex element"},
     {"noz.ply",
      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
      "property float y\nproperty float w\nend_header\n1 2 3\n",
-     0, SC_FILE_EFORMAT, "line 7: ", "no property 'z'"},
+     0, SCF_EFORMAT, "line 7: ", "no property 'z'"},
     {"listx.ply",
      "ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\n"
      "property float y\nproperty float z\nend_header\n1 2 3\n",
-     0, SC_FILE_EFORMAT, "line 7: ", "vertex property 'x' is a list"},
+     0, SCF_EFORMAT, "line 7: ", "vertex property 'x' is a list"},
     {"twovertex.ply",
      "ply\nformat ascii 1.0\nelement vertex 1\n" VX "element vertex 1\n" VX
      "end_header\n",
-     0, SC_FILE_EFORMAT, "line 11: ", "two vertex elements"},
+     0, SCF_EFORMAT, "line 11: ", "two vertex elements"},
     {"noindices.ply",
      "ply\nformat ascii 1.0\nelement vertex 3\n" VX
      "element face 1\nproperty list uchar int corners\nend_header\n"
      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
-     1, SC_FILE_EFORMAT, "line 9: ", "no vertex_indices list"},
+     1, SCF_EFORMAT, "line 9: ", "no vertex_indices list"},
     {"floatindices.ply",
      "ply\nformat ascii 1.0\nelement vertex 3\n" VX
      "element face 1\nproperty list uchar float vertex_indices\nend_header\n"
      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
-     1, SC_FILE_EFORMAT, "line 9: ", "not of an integer type"},
+     1, SCF_EFORMAT, "line 9: ", "not of an integer type"},
 };
 
 static void run_cases(const bad_case_t *cases, size_t n) {
@@ -129,12 +129,12 @@ static void run_cases(const bad_case_t *cases, size_t n) {
  * read fine. */
 static void test_bad_headers(void) {
   run_cases(bad_headers, sizeof bad_headers / sizeof bad_headers[0]);
-  sc_points_t p;
+  scf_points_t p;
   char msg[256];
-  CHECK_INT_EQ(sc_points_read(tmp_path("noindices.ply"), &p, msg, sizeof msg),
+  CHECK_INT_EQ(scf_points_read(tmp_path("noindices.ply"), &p, msg, sizeof msg),
                0);
   CHECK_U64_EQ(p.count, 3);
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 /*
@@ -154,7 +154,7 @@ static void test_counts_beyond_file(void) {
   buf_write(&b, path);
   char want[128];
   snprintf(want, sizeof want, "byte %zu: ", header + 36);
-  expect_fail(path, 0, SC_FILE_EFORMAT, want,
+  expect_fail(path, 0, SCF_EFORMAT, want,
               "file ends before vertex 3 of 1152921504606846976");
   buf_free(&b);
 
@@ -169,7 +169,7 @@ static void test_counts_beyond_file(void) {
   path = tmp_path("overflow.ply");
   buf_write(&b, path);
   snprintf(want, sizeof want, "byte %zu: ", header);
-  expect_fail(path, 0, SC_FILE_EFORMAT, want,
+  expect_fail(path, 0, SCF_EFORMAT, want,
               "file ends inside vertex 0 of 9223372036854775807 (expected 24 "
               "bytes, got 8)");
   buf_free(&b);
@@ -185,7 +185,7 @@ static void test_counts_beyond_file(void) {
   path = tmp_path("junk.ply");
   buf_write(&b, path);
   snprintf(want, sizeof want, "byte %zu: ", header);
-  expect_fail(path, 0, SC_FILE_EFORMAT, want,
+  expect_fail(path, 0, SCF_EFORMAT, want,
               "declares 1000000000000 junk records");
   buf_free(&b);
 
@@ -203,40 +203,40 @@ static void test_counts_beyond_file(void) {
   path = tmp_path("faces.ply");
   buf_write(&b, path);
   snprintf(want, sizeof want, "byte %zu: ", header);
-  expect_fail(path, 1, SC_FILE_EFORMAT, want, "4000000000 face records");
+  expect_fail(path, 1, SCF_EFORMAT, want, "4000000000 face records");
   buf_free(&b);
-  sc_points_t p;
+  scf_points_t p;
   char msg[256];
-  CHECK_INT_EQ(sc_points_read(path, &p, msg, sizeof msg), 0);
+  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), 0);
   CHECK_U64_EQ(p.count, 3);
-  sc_points_free(&p);
+  scf_points_free(&p);
 
   static const bad_case_t text[] = {
       {"huge_ascii.ply",
        "ply\nformat ascii 1.0\nelement vertex 1000000000000\n" VX
        "end_header\n1 2 3\n4 5 6\n",
-       0, SC_FILE_EFORMAT, "line 7: ", "declares 1000000000000 vertex"},
+       0, SCF_EFORMAT, "line 7: ", "declares 1000000000000 vertex"},
       /* Enough bytes for the size check, too few values. */
       {"short_ascii.ply",
        "ply\nformat ascii 1.0\nelement vertex 3\n" VX "end_header\n"
        "1.0 2.0 3.0\n4.0 5.0 6.0\n7.0 8.0\n",
-       0, SC_FILE_EFORMAT,
+       0, SCF_EFORMAT,
        "line 10: ", "file ends inside vertex 2 of 3 (expected property 'z')"},
       {"short_list.ply",
        "ply\nformat ascii 1.0\nelement vertex 3\n" VX
        "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
        "1.0 2.0 3.0\n4.0 5.0 6.0\n7.0 8.0 9.0\n3 0 1\n",
-       1, SC_FILE_EFORMAT, "line 13: ",
+       1, SCF_EFORMAT, "line 13: ",
        "file ends inside face 0 of 1 (expected an item of list "
        "'vertex_indices')"},
-      {"huge.off", "OFF\n# counts\n1000000000 0 0\n0 0 0\n", 0, SC_FILE_EFORMAT,
+      {"huge.off", "OFF\n# counts\n1000000000 0 0\n0 0 0\n", 0, SCF_EFORMAT,
        "line 3: ", "declares 1000000000 vertices"},
       {"hugefaces.off", "OFF\n3 1000000000 0\n0 0 0\n1 0 0\n0 1 0\n", 1,
-       SC_FILE_EFORMAT, "line 2: ", "and faces 1000000000"},
+       SCF_EFORMAT, "line 2: ", "and faces 1000000000"},
       /* Long enough to pass the size check, but short of the counts. */
-      {"short.off", "OFF\n3 0 0\n0.5 0.5 0.5\n1.5 0 0\n", 0, SC_FILE_EFORMAT,
+      {"short.off", "OFF\n3 0 0\n0.5 0.5 0.5\n1.5 0 0\n", 0, SCF_EFORMAT,
        "line 4: ", "file ends after 2 of 3 vertices"},
-      {"shortfaces.off", "OFF\n3 2 0\n" V3 "3 0 1 2\n", 1, SC_FILE_EFORMAT,
+      {"shortfaces.off", "OFF\n3 2 0\n" V3 "3 0 1 2\n", 1, SCF_EFORMAT,
        "line 6: ", "file ends after 1 of 2 faces"},
   };
   run_cases(text, sizeof text / sizeof text[0]);
@@ -250,11 +250,11 @@ static void test_counts_beyond_file(void) {
   stl[82] = 0x0f;
   path = tmp_path("huge.stl");
   write_bytes(path, stl, sizeof stl);
-  expect_fail(path, 1, SC_FILE_EFORMAT,
+  expect_fail(path, 1, SCF_EFORMAT,
               "byte 80: ", "declares 1000000 triangles");
   path = tmp_path("tiny.stl");
   write_bytes(path, stl, 40);
-  expect_fail(path, 1, SC_FILE_EFORMAT,
+  expect_fail(path, 1, SCF_EFORMAT,
               "byte 40: ", "inside the 84-byte binary STL header");
 }
 
@@ -296,7 +296,7 @@ static void check_cut(const char *path, int mesh, const layout_t *l,
     /* Only the line end after end_header is missing: the header is whole
      * and the data, all of it missing, begins where the file ends. */
     snprintf(want1, sizeof want1, "byte %zu: ", cut);
-    expect_fail(path, mesh, SC_FILE_EFORMAT, want1,
+    expect_fail(path, mesh, SCF_EFORMAT, want1,
                 generic ? generic : "file ends before vertex 0 of 5");
     return;
   }
@@ -304,19 +304,19 @@ static void check_cut(const char *path, int mesh, const layout_t *l,
     /* Inside the header the reader works in lines. A cut can also leave
      * a valid-looking but unsupported line ("format ascii 1"). */
     char msg[256];
-    sc_points_t p;
+    scf_points_t p;
     uint32_t *tri;
     size_t nt;
-    int rc = mesh ? sc_mesh_read(path, &p, &tri, &nt, msg, sizeof msg)
-                  : sc_points_read(path, &p, msg, sizeof msg);
-    if (rc != SC_FILE_EFORMAT && rc != SC_FILE_EUNSUPPORTED)
-      CHECK_FAIL_("cut at %zu: %s (%s)", cut, sc_file_err_name(rc), msg);
+    int rc = mesh ? scf_mesh_read(path, &p, &tri, &nt, msg, sizeof msg)
+                  : scf_points_read(path, &p, msg, sizeof msg);
+    if (rc != SCF_EFORMAT && rc != SCF_EUNSUPPORTED)
+      CHECK_FAIL_("cut at %zu: %s (%s)", cut, scf_err_name(rc), msg);
     CHECK_CONTAINS(msg, ": line ");
     return;
   }
   if (generic != NULL) {
     snprintf(want1, sizeof want1, "byte %zu: ", header);
-    expect_fail(path, mesh, SC_FILE_EFORMAT, want1, generic);
+    expect_fail(path, mesh, SCF_EFORMAT, want1, generic);
     return;
   }
   const piece_t *pc = NULL;
@@ -334,7 +334,7 @@ static void check_cut(const char *path, int mesh, const layout_t *l,
              "file ends inside %s %d of %s (expected %zu bytes, got %zu)",
              pc->elem, pc->rec, strcmp(pc->elem, "vertex") ? "4" : "5",
              pc->size, got);
-  expect_fail(path, mesh, SC_FILE_EFORMAT, want1, want2);
+  expect_fail(path, mesh, SCF_EFORMAT, want1, want2);
 }
 
 static void test_every_cut(void) {
@@ -416,57 +416,57 @@ static void test_every_cut(void) {
                                : NULL);
       }
       buf_write(&b, path);
-      sc_points_t p;
+      scf_points_t p;
       uint32_t *tri;
       size_t nt;
       char msg[256];
-      CHECK_INT_EQ(sc_mesh_read(path, &p, &tri, &nt, msg, sizeof msg), 0);
+      CHECK_INT_EQ(scf_mesh_read(path, &p, &tri, &nt, msg, sizeof msg), 0);
       CHECK_U64_EQ(p.count, 5);
       CHECK_U64_EQ(nt, 4);
       CHECK_DBL_SAME(p.xyz[13], -4.0);
       free(tri);
-      sc_points_free(&p);
+      scf_points_free(&p);
       buf_free(&b);
     }
 }
 
 /* A token that is not a number is reported with its line. */
 static const bad_case_t bad_tokens[] = {
-    {"word.xyz", "1 2 3\n4 5 6\n\n7 eight 9\n", 0, SC_FILE_EFORMAT,
+    {"word.xyz", "1 2 3\n4 5 6\n\n7 eight 9\n", 0, SCF_EFORMAT,
      "line 4: ", "expected 3 numbers, got 'eight'"},
-    {"suffix.txt", "# c\n1 2 3abc\n", 0, SC_FILE_EFORMAT,
+    {"suffix.txt", "# c\n1 2 3abc\n", 0, SCF_EFORMAT,
      "line 2: ", "got '3abc'"},
-    {"two.xyz", "1 2 3\r\n1 2\r\n", 0, SC_FILE_EFORMAT,
+    {"two.xyz", "1 2 3\r\n1 2\r\n", 0, SCF_EFORMAT,
      "line 2: ", "expected 3 numbers, got 2"},
-    {"ctrl.xyz", "1 2 \x01\x02x\n", 0, SC_FILE_EFORMAT,
+    {"ctrl.xyz", "1 2 \x01\x02x\n", 0, SCF_EFORMAT,
      "line 1: ", "got '??x'"},
     {"long.xyz",
      "1 2 zzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzz\n", 0,
-     SC_FILE_EFORMAT,
+     SCF_EFORMAT,
      "line 1: ", "got 'zzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzzz...'"},
-    {"vertex.off", "OFF\n2 0 0\n0 0 0\n# x\n1 y 0\n", 0, SC_FILE_EFORMAT,
+    {"vertex.off", "OFF\n2 0 0\n0 0 0\n# x\n1 y 0\n", 0, SCF_EFORMAT,
      "line 5: ", "expected 3 numbers for a vertex, got 'y'"},
-    {"counts.off", "OFF\nthree 0 0\n", 0, SC_FILE_EFORMAT,
+    {"counts.off", "OFF\nthree 0 0\n", 0, SCF_EFORMAT,
      "line 2: ", "expected the vertex and face counts, got 'three'"},
-    {"index.off", "OFF\n3 1 0\n" V3 "3 0 1 two\n", 1, SC_FILE_EFORMAT,
+    {"index.off", "OFF\n3 1 0\n" V3 "3 0 1 two\n", 1, SCF_EFORMAT,
      "line 6: ", "got 'two'"},
-    {"v.obj", "v 0 0 0\nvn 1 2 3\nv 1 2 three\n", 0, SC_FILE_EFORMAT,
+    {"v.obj", "v 0 0 0\nvn 1 2 3\nv 1 2 three\n", 0, SCF_EFORMAT,
      "line 3: ", "expected 3 numbers after 'v', got 'three'"},
-    {"f.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", 1, SC_FILE_EFORMAT,
+    {"f.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", 1, SCF_EFORMAT,
      "line 4: ", "expected a vertex index"},
     {"value.ply",
      "ply\nformat ascii 1.0\nelement vertex 2\n" VX "end_header\n"
      "1 2 3\n4 5 oops\n",
-     0, SC_FILE_EFORMAT, "line 9: ", "property 'z' of vertex 1, got 'oops'"},
+     0, SCF_EFORMAT, "line 9: ", "property 'z' of vertex 1, got 'oops'"},
     {"list.ply",
      "ply\nformat ascii 1.0\nelement vertex 1\n" VX
      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
      "1 2 3\nthree 0 0 0\n",
-     1, SC_FILE_EFORMAT, "line 11: ", "list length for 'vertex_indices'"},
+     1, SCF_EFORMAT, "line 11: ", "list length for 'vertex_indices'"},
     {"vertex.stl",
      "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
      "vertex 1 0 q\n",
-     1, SC_FILE_EFORMAT, "line 5: ", "after 'vertex', got 'q'"},
+     1, SCF_EFORMAT, "line 5: ", "after 'vertex', got 'q'"},
 };
 
 /* Faces that name vertices the file does not have, or too few. */
@@ -475,53 +475,53 @@ static const bad_case_t bad_faces[] = {
      "ply\nformat ascii 1.0\nelement vertex 3\n" VX
      "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 3\n",
-     1, SC_FILE_EFORMAT,
+     1, SCF_EFORMAT,
      "line 14: ", "face 1 refers to vertex 3, but there are 3 vertices"},
     {"negative.ply",
      "ply\nformat ascii 1.0\nelement vertex 3\n" VX
      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
      "0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n",
-     1, SC_FILE_EFORMAT, "line 13: ", "refers to vertex -1"},
+     1, SCF_EFORMAT, "line 13: ", "refers to vertex -1"},
     {"two.ply",
      "ply\nformat ascii 1.0\nelement vertex 3\n" VX
      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
      "0 0 0\n1 0 0\n0 1 0\n2 0 1\n",
-     1, SC_FILE_EFORMAT, "line 13: ", "face 0 has 2 vertices"},
-    {"range.off", "OFF\n3 1 0\n" V3 "3 0 1 3\n", 1, SC_FILE_EFORMAT,
+     1, SCF_EFORMAT, "line 13: ", "face 0 has 2 vertices"},
+    {"range.off", "OFF\n3 1 0\n" V3 "3 0 1 3\n", 1, SCF_EFORMAT,
      "line 6: ", "vertex index below 3 in face 0, got '3'"},
-    {"two.off", "OFF\n3 1 0\n" V3 "2 0 1\n", 1, SC_FILE_EFORMAT,
+    {"two.off", "OFF\n3 1 0\n" V3 "2 0 1\n", 1, SCF_EFORMAT,
      "line 6: ", "vertex count of at least 3"},
-    {"few.off", "OFF\n3 1 0\n" V3 "3 0 1\n", 1, SC_FILE_EFORMAT,
+    {"few.off", "OFF\n3 1 0\n" V3 "3 0 1\n", 1, SCF_EFORMAT,
      "line 6: ", "face 0 has 2 of its 3 vertex indices"},
     {"range.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\nf 1 2 4\n", 1,
-     SC_FILE_EFORMAT,
+     SCF_EFORMAT,
      "line 5: ", "face refers to vertex 4, but the file has 3 vertices"},
-    {"zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", 1, SC_FILE_EFORMAT,
+    {"zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", 1, SCF_EFORMAT,
      "line 4: ", "got '0'"},
     {"before.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", 1,
-     SC_FILE_EFORMAT, "line 4: ", "relative vertex index -4"},
-    {"two.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n", 1, SC_FILE_EFORMAT,
+     SCF_EFORMAT, "line 4: ", "relative vertex index -4"},
+    {"two.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n", 1, SCF_EFORMAT,
      "line 3: ", "face with 2 vertices"},
     {"loop.stl", "solid s\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n",
-     1, SC_FILE_EFORMAT, "line 5: ", "loop with 2 vertices"},
-    {"outside.stl", "solid s\nvertex 0 0 0\n", 1, SC_FILE_EFORMAT,
+     1, SCF_EFORMAT, "line 5: ", "loop with 2 vertices"},
+    {"outside.stl", "solid s\nvertex 0 0 0\n", 1, SCF_EFORMAT,
      "line 2: ", "vertex outside an 'outer loop'"},
-    {"open.stl", "solid s\nouter loop\nvertex 0 0 0\n", 1, SC_FILE_EFORMAT,
+    {"open.stl", "solid s\nouter loop\nvertex 0 0 0\n", 1, SCF_EFORMAT,
      "file ends inside a facet", NULL},
     {"keyword.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertx 0 0 0\n", 1,
-     SC_FILE_EFORMAT, "line 4: ", "expected an STL keyword, got 'vertx'"},
+     SCF_EFORMAT, "line 4: ", "expected an STL keyword, got 'vertx'"},
 };
 
 /* Other kinds of text that are not what the extension says. */
 static const bad_case_t bad_text[] = {
-    {"notoff.off", "# OFF\nOFFICE 1 0 0\n", 0, SC_FILE_EFORMAT,
+    {"notoff.off", "# OFF\nOFFICE 1 0 0\n", 0, SCF_EFORMAT,
      "line 2: ", "not an OFF file: expected 'OFF' first, got 'OFFICE'"},
-    {"emptyoff.off", "", 0, SC_FILE_EFORMAT, "line 1: ", "not an OFF file"},
-    {"four.off", "4OFF\n1 0 0\n0 0 0 0\n", 0, SC_FILE_EUNSUPPORTED,
+    {"emptyoff.off", "", 0, SCF_EFORMAT, "line 1: ", "not an OFF file"},
+    {"four.off", "4OFF\n1 0 0\n0 0 0 0\n", 0, SCF_EUNSUPPORTED,
      "line 1: ", "'4OFF'"},
-    {"binary.off", "OFF BINARY\n", 0, SC_FILE_EUNSUPPORTED,
+    {"binary.off", "OFF BINARY\n", 0, SCF_EUNSUPPORTED,
      "line 1: ", "binary OFF"},
-    {"nocounts.off", "OFF\n# nothing else\n", 0, SC_FILE_EFORMAT,
+    {"nocounts.off", "OFF\n# nothing else\n", 0, SCF_EFORMAT,
      "file ends before the vertex and face counts", NULL},
 };
 
@@ -532,7 +532,7 @@ static void test_bad_text(void) {
   /* A NUL inside a line, as in a binary file given a text extension. */
   const char *path = tmp_path("nul.xyz");
   write_bytes(path, "1 2 3\n4 5\0 6\n", 13);
-  expect_fail(path, 0, SC_FILE_EFORMAT, "line 2: ", "NUL byte");
+  expect_fail(path, 0, SCF_EFORMAT, "line 2: ", "NUL byte");
 
   /* A binary face list: the offending index is named by its offset. */
   buf_t b = {0};
@@ -553,13 +553,13 @@ static void test_bad_text(void) {
   buf_write(&b, path);
   char want[64];
   snprintf(want, sizeof want, "byte %zu: ", face1 + 5);
-  expect_fail(path, 1, SC_FILE_EFORMAT, want,
+  expect_fail(path, 1, SCF_EFORMAT, want,
               "face 1 refers to vertex 4000000000, but there are 3");
   /* A negative list length. */
   b.p[face1] = 0xff;
   buf_write(&b, path);
   snprintf(want, sizeof want, "byte %zu: ", face1);
-  expect_fail(path, 1, SC_FILE_EFORMAT, want, "negative list length -1");
+  expect_fail(path, 1, SCF_EFORMAT, want, "negative list length -1");
   buf_free(&b);
 
   /* A line longer than the reader takes (64 KiB). */
@@ -572,32 +572,32 @@ static void test_bad_text(void) {
   memcpy(text + 6 + n, "4 5 6\n", 6);
   write_bytes(path, text, n + 12);
   free(text);
-  expect_fail(path, 0, SC_FILE_EFORMAT, "line 2: ", "line longer than");
+  expect_fail(path, 0, SCF_EFORMAT, "line 2: ", "line longer than");
 }
 
 /* Files that cannot be read at all, and extensions that are not known. */
 static void test_unreadable(void) {
-  expect_fail(tmp_path("missing.ply"), 0, SC_FILE_ENOENT, "cannot open", NULL);
-  expect_fail(tmp_path("missing.obj"), 1, SC_FILE_ENOENT, "cannot open", NULL);
+  expect_fail(tmp_path("missing.ply"), 0, SCF_ENOENT, "cannot open", NULL);
+  expect_fail(tmp_path("missing.obj"), 1, SCF_ENOENT, "cannot open", NULL);
   const char *dir = tmp_path("dir.xyz");
   CHECK(mkdir(dir, 0700) == 0);
-  expect_fail(dir, 0, SC_FILE_EIO, "is a directory", NULL);
+  expect_fail(dir, 0, SCF_EIO, "is a directory", NULL);
 
   /* The extension is judged before the file is looked at. */
-  expect_fail(tmp_path("points.las"), 0, SC_FILE_EUNSUPPORTED,
+  expect_fail(tmp_path("points.las"), 0, SCF_EUNSUPPORTED,
               "unknown extension '.las'", "expected .ply, .xyz");
-  expect_fail(tmp_path("points"), 0, SC_FILE_EUNSUPPORTED, "no file extension",
+  expect_fail(tmp_path("points"), 0, SCF_EUNSUPPORTED, "no file extension",
               NULL);
-  expect_fail(tmp_path("dir.ply/points"), 0, SC_FILE_EUNSUPPORTED,
+  expect_fail(tmp_path("dir.ply/points"), 0, SCF_EUNSUPPORTED,
               "no file extension", NULL);
-  expect_fail(tmp_path(".ply"), 0, SC_FILE_EUNSUPPORTED, "no file extension",
+  expect_fail(tmp_path(".ply"), 0, SCF_EUNSUPPORTED, "no file extension",
               NULL);
-  expect_fail(tmp_path("points.plyy"), 0, SC_FILE_EUNSUPPORTED,
+  expect_fail(tmp_path("points.plyy"), 0, SCF_EUNSUPPORTED,
               "unknown extension '.plyy'", NULL);
   /* Point-only formats are no meshes, and STL has no point-only use. */
-  expect_fail(tmp_path("mesh.xyz"), 1, SC_FILE_EUNSUPPORTED,
+  expect_fail(tmp_path("mesh.xyz"), 1, SCF_EUNSUPPORTED,
               "unknown extension '.xyz'", "expected .ply, .off, .obj or .stl");
-  expect_fail(tmp_path("mesh.stl"), 0, SC_FILE_EUNSUPPORTED,
+  expect_fail(tmp_path("mesh.stl"), 0, SCF_EUNSUPPORTED,
               "unknown extension '.stl'", NULL);
 }
 
@@ -606,13 +606,13 @@ static void test_unreadable(void) {
 static void test_write_bad_index(void) {
   static const double xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   static const uint32_t tri[6] = {0, 1, 2, 2, 1, 3};
-  for (int fmt = SC_MESH_FMT_AUTO; fmt <= SC_MESH_FMT_STL_ASCII; fmt++) {
+  for (int fmt = SCF_MESH_FMT_AUTO; fmt <= SCF_MESH_FMT_STL_ASCII; fmt++) {
     char name[32], msg[256];
     snprintf(name, sizeof name, "bad%d.obj", fmt);
     const char *path = tmp_path(name);
-    CHECK_INT_EQ(sc_mesh_write(path, (sc_mesh_format_t)fmt, xyz, 3, tri, 2,
+    CHECK_INT_EQ(scf_mesh_write(path, (scf_mesh_format_t)fmt, xyz, 3, tri, 2,
                                NULL, msg, sizeof msg),
-                 SC_FILE_EINVAL);
+                 SCF_EINVAL);
     CHECK_CONTAINS(msg, path);
     CHECK_CONTAINS(msg, "triangle 1 refers to point 3, but there are 3");
     struct stat st;
@@ -622,32 +622,32 @@ static void test_write_bad_index(void) {
   const char *path = tmp_path("keep.ply");
   write_text(path, "old contents\n");
   char msg[256];
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_AUTO, xyz, 3, tri, 2, NULL, msg,
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, 3, tri, 2, NULL, msg,
                              sizeof msg),
-               SC_FILE_EINVAL);
+               SCF_EINVAL);
   char *s = read_all(path, NULL);
   CHECK_STR_EQ(s, "old contents\n");
   free(s);
   CHECK_INT_EQ(count_entries(tmp_path(""), ".tmp."), 0);
 
   /* Other refusals that come before any file is created. */
-  CHECK_INT_EQ(sc_mesh_write(path, (sc_mesh_format_t)99, xyz, 3, tri, 1, NULL,
+  CHECK_INT_EQ(scf_mesh_write(path, (scf_mesh_format_t)99, xyz, 3, tri, 1, NULL,
                              msg, sizeof msg),
-               SC_FILE_EINVAL);
+               SCF_EINVAL);
   CHECK_CONTAINS(msg, "unknown format 99");
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_OFF, NULL, 3, tri, 1, NULL, msg,
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_OFF, NULL, 3, tri, 1, NULL, msg,
                              sizeof msg),
-               SC_FILE_EINVAL);
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_OFF, xyz, 3, NULL, 1, NULL, msg,
+               SCF_EINVAL);
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_OFF, xyz, 3, NULL, 1, NULL, msg,
                              sizeof msg),
-               SC_FILE_EINVAL);
-  CHECK_INT_EQ(sc_mesh_write(NULL, SC_MESH_FMT_OFF, xyz, 3, tri, 1, NULL, msg,
+               SCF_EINVAL);
+  CHECK_INT_EQ(scf_mesh_write(NULL, SCF_MESH_FMT_OFF, xyz, 3, tri, 1, NULL, msg,
                              sizeof msg),
-               SC_FILE_EINVAL);
+               SCF_EINVAL);
   CHECK_CONTAINS(msg, "(null)");
-  CHECK_INT_EQ(sc_mesh_write(tmp_path("dir.ply/"), SC_MESH_FMT_OFF, xyz, 3, tri,
+  CHECK_INT_EQ(scf_mesh_write(tmp_path("dir.ply/"), SCF_MESH_FMT_OFF, xyz, 3, tri,
                              1, NULL, msg, sizeof msg),
-               SC_FILE_EINVAL);
+               SCF_EINVAL);
   CHECK_CONTAINS(msg, "not a file name");
   s = read_all(path, NULL);
   CHECK_STR_EQ(s, "old contents\n");
@@ -656,38 +656,38 @@ static void test_write_bad_index(void) {
 
 static void test_arguments(void) {
   char msg[256];
-  sc_points_t p = {(double *)msg, 9};
-  CHECK_INT_EQ(sc_points_read(NULL, &p, msg, sizeof msg), SC_FILE_EINVAL);
+  scf_points_t p = {(double *)msg, 9};
+  CHECK_INT_EQ(scf_points_read(NULL, &p, msg, sizeof msg), SCF_EINVAL);
   CHECK(p.xyz == NULL && p.count == 0);
-  CHECK_INT_EQ(sc_points_read("a.xyz", NULL, msg, sizeof msg), SC_FILE_EINVAL);
+  CHECK_INT_EQ(scf_points_read("a.xyz", NULL, msg, sizeof msg), SCF_EINVAL);
   CHECK_CONTAINS(msg, "a.xyz: NULL");
   uint32_t *tri = (uint32_t *)msg;
   size_t nt = 3;
-  p = (sc_points_t){(double *)msg, 9};
-  CHECK_INT_EQ(sc_mesh_read("a.ply", &p, &tri, NULL, msg, sizeof msg),
-               SC_FILE_EINVAL);
+  p = (scf_points_t){(double *)msg, 9};
+  CHECK_INT_EQ(scf_mesh_read("a.ply", &p, &tri, NULL, msg, sizeof msg),
+               SCF_EINVAL);
   CHECK(p.xyz == NULL && p.count == 0 && tri == NULL);
-  CHECK_INT_EQ(sc_mesh_read("a.ply", &p, NULL, &nt, msg, sizeof msg),
-               SC_FILE_EINVAL);
+  CHECK_INT_EQ(scf_mesh_read("a.ply", &p, NULL, &nt, msg, sizeof msg),
+               SCF_EINVAL);
   CHECK_U64_EQ(nt, 0);
 
   /* Messages are cut to the buffer, and no buffer is fine. */
   const char *path = tmp_path("missing.xyz");
   char small[12];
   memset(small, 'x', sizeof small);
-  CHECK_INT_EQ(sc_points_read(path, &p, small, sizeof small), SC_FILE_ENOENT);
+  CHECK_INT_EQ(scf_points_read(path, &p, small, sizeof small), SCF_ENOENT);
   CHECK_U64_EQ(strlen(small), sizeof small - 1);
   CHECK(strncmp(small, path, sizeof small - 1) == 0);
-  CHECK_INT_EQ(sc_points_read(path, &p, NULL, 0), SC_FILE_ENOENT);
+  CHECK_INT_EQ(scf_points_read(path, &p, NULL, 0), SCF_ENOENT);
   memset(small, 'x', sizeof small);
-  CHECK_INT_EQ(sc_points_read(path, &p, small, 0), SC_FILE_ENOENT);
+  CHECK_INT_EQ(scf_points_read(path, &p, small, 0), SCF_ENOENT);
   CHECK(small[0] == 'x');
   /* A success clears an old message. */
   write_text(tmp_path("ok.xyz"), "1 2 3\n");
   strcpy(msg, "stale");
-  CHECK_INT_EQ(sc_points_read(tmp_path("ok.xyz"), &p, msg, sizeof msg), 0);
+  CHECK_INT_EQ(scf_points_read(tmp_path("ok.xyz"), &p, msg, sizeof msg), 0);
   CHECK_STR_EQ(msg, "");
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 /* One table gives every code its name and text. */
@@ -696,24 +696,24 @@ static void test_codes(void) {
     int code;
     const char *name, *text;
   } codes[] = {
-      {SC_FILE_OK, "OK", "success"},
-      {SC_FILE_EINVAL, "EINVAL", "invalid argument"},
-      {SC_FILE_ENOENT, "ENOENT", "no such file"},
-      {SC_FILE_EIO, "EIO", "input/output error"},
-      {SC_FILE_EFORMAT, "EFORMAT", "malformed file"},
-      {SC_FILE_EUNSUPPORTED, "EUNSUPPORTED", "unsupported file format"},
-      {SC_FILE_ENOMEM, "ENOMEM", "out of memory"},
+      {SCF_OK, "OK", "success"},
+      {SCF_EINVAL, "EINVAL", "invalid argument"},
+      {SCF_ENOENT, "ENOENT", "no such file"},
+      {SCF_EIO, "EIO", "input/output error"},
+      {SCF_EFORMAT, "EFORMAT", "malformed file"},
+      {SCF_EUNSUPPORTED, "EUNSUPPORTED", "unsupported file format"},
+      {SCF_ENOMEM, "ENOMEM", "out of memory"},
   };
   for (size_t i = 0; i < sizeof codes / sizeof codes[0]; i++) {
-    CHECK_STR_EQ(sc_file_err_name(codes[i].code), codes[i].name);
-    CHECK_STR_EQ(sc_file_strerror(codes[i].code), codes[i].text);
+    CHECK_STR_EQ(scf_err_name(codes[i].code), codes[i].name);
+    CHECK_STR_EQ(scf_strerror(codes[i].code), codes[i].text);
     if (i > 0)
       CHECK_INT_EQ(codes[i].code, -100 - (int)i);
   }
-  CHECK_STR_EQ(sc_file_err_name(-100), "UNKNOWN");
-  CHECK_STR_EQ(sc_file_err_name(-107), "UNKNOWN");
-  CHECK_STR_EQ(sc_file_err_name(1), "UNKNOWN");
-  CHECK_STR_EQ(sc_file_strerror(-107), "unknown error");
+  CHECK_STR_EQ(scf_err_name(-100), "UNKNOWN");
+  CHECK_STR_EQ(scf_err_name(-107), "UNKNOWN");
+  CHECK_STR_EQ(scf_err_name(1), "UNKNOWN");
+  CHECK_STR_EQ(scf_strerror(-107), "unknown error");
 }
 
 int main(void) {

@@ -8,7 +8,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "check.h"
-#include "files.h"
+#include "shortcrust_files.h"
 #include "plybuf.h"
 
 #include <math.h>
@@ -26,19 +26,19 @@ static const double values[TY_COUNT][4] = {
     [F64] = {0.1, -1e300, 5e-324, 123456789.12345679},
 };
 
-static void read_ok(const char *path, sc_points_t *p) {
+static void read_ok(const char *path, scf_points_t *p) {
   char msg[512];
-  int rc = sc_points_read(path, p, msg, sizeof msg);
+  int rc = scf_points_read(path, p, msg, sizeof msg);
   if (rc != 0)
-    CHECK_FAIL_("reading %s: %s (%s)", path, sc_file_err_name(rc), msg);
+    CHECK_FAIL_("reading %s: %s (%s)", path, scf_err_name(rc), msg);
 }
 
-static void mesh_ok(const char *path, sc_points_t *p, uint32_t **tri,
+static void mesh_ok(const char *path, scf_points_t *p, uint32_t **tri,
                     size_t *nt) {
   char msg[512];
-  int rc = sc_mesh_read(path, p, tri, nt, msg, sizeof msg);
+  int rc = scf_mesh_read(path, p, tri, nt, msg, sizeof msg);
   if (rc != 0)
-    CHECK_FAIL_("reading %s: %s (%s)", path, sc_file_err_name(rc), msg);
+    CHECK_FAIL_("reading %s: %s (%s)", path, scf_err_name(rc), msg);
 }
 
 /*
@@ -95,14 +95,14 @@ static void test_types(void) {
           buf_write(&b, path);
           buf_free(&b);
 
-          sc_points_t p;
+          scf_points_t p;
           read_ok(path, &p);
           CHECK_U64_EQ(p.count, 4);
           for (int i = 0; i < 4; i++)
             for (int c = 0; c < 3; c++)
               CHECK_DBL_SAME(p.xyz[3 * i + c],
                              ty_round((ty_t)t, values[t][(i + c) % 4]));
-          sc_points_free(&p);
+          scf_points_free(&p);
 
           /* The same file as a mesh: the vertices and one triangle. */
           uint32_t *tri;
@@ -115,7 +115,7 @@ static void test_types(void) {
           CHECK_U64_EQ(tri[2], 2);
           CHECK_DBL_SAME(p.xyz[11], ty_round((ty_t)t, values[t][1]));
           free(tri);
-          sc_points_free(&p);
+          scf_points_free(&p);
         }
 }
 
@@ -204,7 +204,7 @@ static void test_faces(void) {
         buf_write(&b, path);
         buf_free(&b);
 
-        sc_points_t p;
+        scf_points_t p;
         uint32_t *tri;
         size_t nt;
         mesh_ok(path, &p, &tri, &nt);
@@ -217,13 +217,13 @@ static void test_faces(void) {
           for (int c = 0; c < 3; c++)
             CHECK_U64_EQ(tri[3 * t + c], pyramid_tris[t][c]);
         free(tri);
-        sc_points_free(&p);
+        scf_points_free(&p);
 
         /* As points, the faces are not even looked at. */
         read_ok(path, &p);
         CHECK_U64_EQ(p.count, 5);
         CHECK_DBL_SAME(p.xyz[14], 1.0);
-        sc_points_free(&p);
+        scf_points_free(&p);
       }
 }
 
@@ -234,7 +234,7 @@ static void test_no_faces(void) {
                    "property float x\nproperty float y\nproperty float z\n"
                    "end_header\n1 2 3\n4 5 6\n");
   static uint32_t junk[3];
-  sc_points_t p;
+  scf_points_t p;
   uint32_t *tri = junk;
   size_t nt = 7;
   mesh_ok(path, &p, &tri, &nt);
@@ -242,7 +242,7 @@ static void test_no_faces(void) {
   CHECK_U64_EQ(nt, 0);
   CHECK(tri == NULL);
   CHECK_DBL_SAME(p.xyz[5], 6.0);
-  sc_points_free(&p);
+  scf_points_free(&p);
 
   path = tmp_path("empty.ply");
   write_text(path, "ply\nformat binary_big_endian 1.0\nelement vertex 0\n"
@@ -258,7 +258,7 @@ static void test_no_faces(void) {
   CHECK_U64_EQ(p.count, 0);
   CHECK_U64_EQ(nt, 0);
   CHECK(tri == NULL);
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 /*
@@ -277,7 +277,7 @@ static void test_ascii_layout(void) {
                    "-0\r\n\r\n  1e300 \r\n 2\r\n"
                    "inf nan 0x1p-3\r\n"
                    "3\r\n0 1\r\n2");
-  sc_points_t p;
+  scf_points_t p;
   uint32_t *tri;
   size_t nt;
   mesh_ok(path, &p, &tri, &nt);
@@ -294,7 +294,7 @@ static void test_ascii_layout(void) {
   CHECK_U64_EQ(nt, 1);
   CHECK_U64_EQ(tri[2], 2);
   free(tri);
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 /*
@@ -340,7 +340,7 @@ static void test_large(void) {
       CHECK(b.n > 4 * 65536);
       buf_free(&b);
 
-      sc_points_t p;
+      scf_points_t p;
       uint32_t *tri;
       size_t nt;
       mesh_ok(path, &p, &tri, &nt);
@@ -368,7 +368,7 @@ static void test_large(void) {
         }
       }
       free(tri);
-      sc_points_free(&p);
+      scf_points_free(&p);
     }
 }
 
@@ -390,13 +390,13 @@ static void test_big_endian_bytes(void) {
   const char *path = tmp_path("be.ply");
   buf_write(&b, path);
   buf_free(&b);
-  sc_points_t p;
+  scf_points_t p;
   read_ok(path, &p);
   CHECK_U64_EQ(p.count, 1);
   CHECK_DBL_SAME(p.xyz[0], 1.0 + 0x1p-52);
   CHECK_DBL_SAME(p.xyz[1], -3.141592653589793);
   CHECK_DBL_SAME(p.xyz[2], (double)(1.0f / 3.0f));
-  sc_points_free(&p);
+  scf_points_free(&p);
 
   /* The same properties reordered so that the integers carry the point. */
   b = (buf_t){0};
@@ -412,7 +412,7 @@ static void test_big_endian_bytes(void) {
   CHECK_DBL_SAME(p.xyz[0], 2147483649.0);
   CHECK_DBL_SAME(p.xyz[1], -2.0);
   CHECK_DBL_SAME(p.xyz[2], 127.0);
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 int main(void) {

@@ -6,7 +6,7 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "check.h"
-#include "files.h"
+#include "shortcrust_files.h"
 
 #include <math.h>
 
@@ -59,20 +59,20 @@ static void make_mesh(void) {
 }
 
 static const struct {
-  sc_mesh_format_t fmt;
+  scf_mesh_format_t fmt;
   const char *ext;
 } formats[] = {
-    {SC_MESH_FMT_PLY_BINARY, "ply"}, {SC_MESH_FMT_PLY_ASCII, "ply"},
-    {SC_MESH_FMT_OFF, "off"},        {SC_MESH_FMT_OBJ, "obj"},
-    {SC_MESH_FMT_STL_BINARY, "stl"}, {SC_MESH_FMT_STL_ASCII, "stl"},
+    {SCF_MESH_FMT_PLY_BINARY, "ply"}, {SCF_MESH_FMT_PLY_ASCII, "ply"},
+    {SCF_MESH_FMT_OFF, "off"},        {SCF_MESH_FMT_OBJ, "obj"},
+    {SCF_MESH_FMT_STL_BINARY, "stl"}, {SCF_MESH_FMT_STL_ASCII, "stl"},
 };
 
 static void check_same_mesh(const char *path, int stl, int stl_float) {
-  sc_points_t p;
+  scf_points_t p;
   uint32_t *t;
   size_t nt;
   char msg[512];
-  int rc = sc_mesh_read(path, &p, &t, &nt, msg, sizeof msg);
+  int rc = scf_mesh_read(path, &p, &t, &nt, msg, sizeof msg);
   if (rc != 0)
     fprintf(stderr, "%s\n", msg);
   CHECK_INT_EQ(rc, 0);
@@ -97,24 +97,24 @@ static void check_same_mesh(const char *path, int stl, int stl_float) {
     }
   }
   free(t);
-  sc_points_free(&p);
+  scf_points_free(&p);
   if (stl)
     return;
-  rc = sc_points_read(path, &p, msg, sizeof msg);
+  rc = scf_points_read(path, &p, msg, sizeof msg);
   CHECK_INT_EQ(rc, 0);
   CHECK_U64_EQ(p.count, N);
   for (int i = 0; i < 3 * N; i++)
     CHECK_DBL_SAME(p.xyz[i], xyz[i]);
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 /* The normals as the file holds them, checked format by format. */
-static void check_normals(const char *path, sc_mesh_format_t fmt,
+static void check_normals(const char *path, scf_mesh_format_t fmt,
                           int with) {
   size_t len;
   char *s = read_all(path, &len);
   switch (fmt) {
-  case SC_MESH_FMT_PLY_BINARY: {
+  case SCF_MESH_FMT_PLY_BINARY: {
     CHECK_INT_EQ(strstr(s, "property float nx\nproperty float ny\n"
                            "property float nz\n") != NULL,
                  with);
@@ -129,7 +129,7 @@ static void check_normals(const char *path, sc_mesh_format_t fmt,
       }
     break;
   }
-  case SC_MESH_FMT_PLY_ASCII: {
+  case SCF_MESH_FMT_PLY_ASCII: {
     const char *body = strstr(s, "end_header\n") + strlen("end_header\n");
     char line[512];
     size_t ll = strcspn(body, "\n");
@@ -144,7 +144,7 @@ static void check_normals(const char *path, sc_mesh_format_t fmt,
       CHECK_DBL_SAME((double)(float)v[3 + c], (double)(float)normals[c]);
     break;
   }
-  case SC_MESH_FMT_OBJ: {
+  case SCF_MESH_FMT_OBJ: {
     int vn = 0;
     for (const char *q = s; (q = strstr(q, "\nvn ")) != NULL; q++)
       vn++;
@@ -166,7 +166,7 @@ static void check_normals(const char *path, sc_mesh_format_t fmt,
     }
     break;
   }
-  case SC_MESH_FMT_STL_BINARY: {
+  case SCF_MESH_FMT_STL_BINARY: {
     CHECK_U64_EQ(len, 84 + 50 * (size_t)NT);
     CHECK(memcmp(s, "solid", 5) != 0);
     for (int i = 0; i < NT; i++) {
@@ -197,40 +197,40 @@ static void test_formats(void) {
       char name[64], msg[512];
       snprintf(name, sizeof name, "mesh_%zu_%d.%s", f, with, formats[f].ext);
       const char *path = tmp_path(name);
-      int rc = sc_mesh_write(path, formats[f].fmt, xyz, N, tri, NT,
+      int rc = scf_mesh_write(path, formats[f].fmt, xyz, N, tri, NT,
                              with ? normals : NULL, msg, sizeof msg);
       if (rc != 0)
         fprintf(stderr, "%s\n", msg);
       CHECK_INT_EQ(rc, 0);
-      int stl = formats[f].fmt == SC_MESH_FMT_STL_BINARY ||
-                formats[f].fmt == SC_MESH_FMT_STL_ASCII;
-      check_same_mesh(path, stl, formats[f].fmt == SC_MESH_FMT_STL_BINARY);
+      int stl = formats[f].fmt == SCF_MESH_FMT_STL_BINARY ||
+                formats[f].fmt == SCF_MESH_FMT_STL_ASCII;
+      check_same_mesh(path, stl, formats[f].fmt == SCF_MESH_FMT_STL_BINARY);
       check_normals(path, formats[f].fmt, with);
     }
 }
 
 static void test_format_from_path(void) {
-  sc_mesh_format_t fmt;
+  scf_mesh_format_t fmt;
   char msg[256];
-  CHECK_INT_EQ(sc_mesh_format_from_path("a/b.ply", 0, &fmt, msg, sizeof msg),
+  CHECK_INT_EQ(scf_mesh_format_from_path("a/b.ply", 0, &fmt, msg, sizeof msg),
                0);
-  CHECK_INT_EQ(fmt, SC_MESH_FMT_PLY_BINARY);
-  CHECK_INT_EQ(sc_mesh_format_from_path("b.PLY", 1, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SC_MESH_FMT_PLY_ASCII);
-  CHECK_INT_EQ(sc_mesh_format_from_path("b.Off", 1, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SC_MESH_FMT_OFF);
-  CHECK_INT_EQ(sc_mesh_format_from_path("b.obj", 0, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SC_MESH_FMT_OBJ);
-  CHECK_INT_EQ(sc_mesh_format_from_path("b.stl", 0, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SC_MESH_FMT_STL_BINARY);
-  CHECK_INT_EQ(sc_mesh_format_from_path("b.STL", 1, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SC_MESH_FMT_STL_ASCII);
-  CHECK_INT_EQ(sc_mesh_format_from_path("out.xyz", 0, &fmt, msg, sizeof msg),
-               SC_FILE_EUNSUPPORTED);
+  CHECK_INT_EQ(fmt, SCF_MESH_FMT_PLY_BINARY);
+  CHECK_INT_EQ(scf_mesh_format_from_path("b.PLY", 1, &fmt, msg, sizeof msg), 0);
+  CHECK_INT_EQ(fmt, SCF_MESH_FMT_PLY_ASCII);
+  CHECK_INT_EQ(scf_mesh_format_from_path("b.Off", 1, &fmt, msg, sizeof msg), 0);
+  CHECK_INT_EQ(fmt, SCF_MESH_FMT_OFF);
+  CHECK_INT_EQ(scf_mesh_format_from_path("b.obj", 0, &fmt, msg, sizeof msg), 0);
+  CHECK_INT_EQ(fmt, SCF_MESH_FMT_OBJ);
+  CHECK_INT_EQ(scf_mesh_format_from_path("b.stl", 0, &fmt, msg, sizeof msg), 0);
+  CHECK_INT_EQ(fmt, SCF_MESH_FMT_STL_BINARY);
+  CHECK_INT_EQ(scf_mesh_format_from_path("b.STL", 1, &fmt, msg, sizeof msg), 0);
+  CHECK_INT_EQ(fmt, SCF_MESH_FMT_STL_ASCII);
+  CHECK_INT_EQ(scf_mesh_format_from_path("out.xyz", 0, &fmt, msg, sizeof msg),
+               SCF_EUNSUPPORTED);
   CHECK_CONTAINS(msg, "out.xyz: unknown extension '.xyz'");
-  CHECK_INT_EQ(sc_mesh_format_from_path("dir.ply/out", 0, &fmt, msg,
+  CHECK_INT_EQ(scf_mesh_format_from_path("dir.ply/out", 0, &fmt, msg,
                                         sizeof msg),
-               SC_FILE_EUNSUPPORTED);
+               SCF_EUNSUPPORTED);
   CHECK_CONTAINS(msg, "dir.ply/out: no file extension");
 }
 
@@ -238,22 +238,22 @@ static void test_format_from_path(void) {
 static void test_auto(void) {
   char msg[256];
   const char *path = tmp_path("auto.PLY");
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_AUTO, xyz, N, tri, NT, NULL,
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL,
                              msg, sizeof msg),
                0);
   char *s = read_all(path, NULL);
   CHECK(strncmp(s, "ply\nformat binary_little_endian 1.0\n", 36) == 0);
   free(s);
   path = tmp_path("auto.obj");
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_AUTO, xyz, N, tri, NT, NULL,
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL,
                              msg, sizeof msg),
                0);
   s = read_all(path, NULL);
   CHECK(strncmp(s, "# written by shortcrust\nv ", 26) == 0);
   free(s);
-  CHECK_INT_EQ(sc_mesh_write(tmp_path("auto.xyz"), SC_MESH_FMT_AUTO, xyz, N,
+  CHECK_INT_EQ(scf_mesh_write(tmp_path("auto.xyz"), SCF_MESH_FMT_AUTO, xyz, N,
                              tri, NT, NULL, msg, sizeof msg),
-               SC_FILE_EUNSUPPORTED);
+               SCF_EUNSUPPORTED);
   CHECK_CONTAINS(msg, "auto.xyz");
   CHECK_INT_EQ(count_entries(tmp_path(""), "auto.xyz"), 0);
 }
@@ -265,36 +265,36 @@ static void test_empty(void) {
     char name[64];
     snprintf(name, sizeof name, "empty_%zu.%s", f, formats[f].ext);
     const char *path = tmp_path(name);
-    size_t n = formats[f].fmt == SC_MESH_FMT_STL_BINARY ||
-                       formats[f].fmt == SC_MESH_FMT_STL_ASCII
+    size_t n = formats[f].fmt == SCF_MESH_FMT_STL_BINARY ||
+                       formats[f].fmt == SCF_MESH_FMT_STL_ASCII
                    ? 0
                    : N;
-    CHECK_INT_EQ(sc_mesh_write(path, formats[f].fmt, xyz, n, NULL, 0, NULL,
+    CHECK_INT_EQ(scf_mesh_write(path, formats[f].fmt, xyz, n, NULL, 0, NULL,
                                msg, sizeof msg),
                  0);
-    sc_points_t p;
+    scf_points_t p;
     uint32_t *t = (uint32_t *)1;
     size_t nt = 99;
-    int rc = sc_mesh_read(path, &p, &t, &nt, msg, sizeof msg);
+    int rc = scf_mesh_read(path, &p, &t, &nt, msg, sizeof msg);
     if (rc != 0)
       fprintf(stderr, "%s\n", msg);
     CHECK_INT_EQ(rc, 0);
     CHECK_U64_EQ(nt, 0);
     CHECK(t == NULL);
     CHECK_U64_EQ(p.count, n);
-    sc_points_free(&p);
+    scf_points_free(&p);
   }
   const char *path = tmp_path("nothing.ply");
-  CHECK_INT_EQ(sc_mesh_write(path, SC_MESH_FMT_AUTO, NULL, 0, NULL, 0, NULL,
+  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, NULL, 0, NULL, 0, NULL,
                              msg, sizeof msg),
                0);
-  sc_points_t p;
-  CHECK_INT_EQ(sc_points_read(path, &p, msg, sizeof msg), 0);
+  scf_points_t p;
+  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), 0);
   CHECK_U64_EQ(p.count, 0);
   CHECK(p.xyz == NULL);
-  sc_points_free(&p);
-  sc_points_free(&p);
-  sc_points_free(NULL);
+  scf_points_free(&p);
+  scf_points_free(&p);
+  scf_points_free(NULL);
 }
 
 /* Non-finite coordinates pass through: the core, not the reader, rejects
@@ -303,17 +303,17 @@ static void test_nonfinite(void) {
   double v[9] = {NAN, 1, 2, INFINITY, -INFINITY, 0, 1, 1, 1};
   uint32_t t[3] = {0, 1, 2};
   char msg[256];
-  const sc_mesh_format_t fmts[] = {SC_MESH_FMT_PLY_BINARY,
-                                   SC_MESH_FMT_PLY_ASCII, SC_MESH_FMT_OFF,
-                                   SC_MESH_FMT_OBJ};
+  const scf_mesh_format_t fmts[] = {SCF_MESH_FMT_PLY_BINARY,
+                                   SCF_MESH_FMT_PLY_ASCII, SCF_MESH_FMT_OFF,
+                                   SCF_MESH_FMT_OBJ};
   const char *names[] = {"nf.ply", "nfa.ply", "nf.off", "nf.obj"};
   for (int f = 0; f < 4; f++) {
     const char *path = tmp_path(names[f]);
-    CHECK_INT_EQ(sc_mesh_write(path, fmts[f], v, 3, t, 1, NULL, msg,
+    CHECK_INT_EQ(scf_mesh_write(path, fmts[f], v, 3, t, 1, NULL, msg,
                                sizeof msg),
                  0);
-    sc_points_t p;
-    int rc = sc_points_read(path, &p, msg, sizeof msg);
+    scf_points_t p;
+    int rc = scf_points_read(path, &p, msg, sizeof msg);
     if (rc != 0)
       fprintf(stderr, "%s\n", msg);
     CHECK_INT_EQ(rc, 0);
@@ -322,7 +322,7 @@ static void test_nonfinite(void) {
     CHECK(isinf(p.xyz[3]) && p.xyz[3] > 0);
     CHECK(isinf(p.xyz[4]) && p.xyz[4] < 0);
     CHECK_DBL_SAME(p.xyz[8], 1.0);
-    sc_points_free(&p);
+    scf_points_free(&p);
   }
 }
 

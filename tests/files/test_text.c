@@ -8,33 +8,33 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "check.h"
-#include "files.h"
+#include "shortcrust_files.h"
 
 #include <math.h>
 
-static void read_ok(const char *path, sc_points_t *p) {
+static void read_ok(const char *path, scf_points_t *p) {
   char msg[512];
-  int rc = sc_points_read(path, p, msg, sizeof msg);
+  int rc = scf_points_read(path, p, msg, sizeof msg);
   if (rc != 0)
-    CHECK_FAIL_("reading %s: %s (%s)", path, sc_file_err_name(rc), msg);
+    CHECK_FAIL_("reading %s: %s (%s)", path, scf_err_name(rc), msg);
 }
 
-static void mesh_ok(const char *path, sc_points_t *p, uint32_t **tri,
+static void mesh_ok(const char *path, scf_points_t *p, uint32_t **tri,
                     size_t *nt) {
   char msg[512];
-  int rc = sc_mesh_read(path, p, tri, nt, msg, sizeof msg);
+  int rc = scf_mesh_read(path, p, tri, nt, msg, sizeof msg);
   if (rc != 0)
-    CHECK_FAIL_("reading %s: %s (%s)", path, sc_file_err_name(rc), msg);
+    CHECK_FAIL_("reading %s: %s (%s)", path, scf_err_name(rc), msg);
 }
 
 /* Writes text to name in the private directory and reads its points. */
-static void points_of(const char *name, const char *text, sc_points_t *p) {
+static void points_of(const char *name, const char *text, scf_points_t *p) {
   const char *path = tmp_path(name);
   write_text(path, text);
   read_ok(path, p);
 }
 
-static void check_points(const sc_points_t *p, const double *want, size_t n) {
+static void check_points(const scf_points_t *p, const double *want, size_t n) {
   CHECK_U64_EQ(p->count, n);
   for (size_t i = 0; i < 3 * n; i++)
     CHECK_DBL_SAME(p->xyz[i], want[i]);
@@ -65,65 +65,65 @@ static void test_xyz_layouts(void) {
     for (size_t e = 0; e < sizeof exts / sizeof exts[0]; e++) {
       char name[32];
       snprintf(name, sizeof name, "layout%zu.%s", t, exts[e]);
-      sc_points_t p;
+      scf_points_t p;
       points_of(name, texts[t], &p);
       check_points(&p, three, 3);
-      sc_points_free(&p);
+      scf_points_free(&p);
     }
 }
 
 /* A .pts file may open with its point count, alone on the line. */
 static void test_pts(void) {
-  sc_points_t p;
+  scf_points_t p;
   points_of("count.pts", "3\n1 2 3\n-4.5 5e-3 6e10\n0.1 -0 9\n", &p);
   check_points(&p, three, 3);
-  sc_points_free(&p);
+  scf_points_free(&p);
   /* After comments and blank lines, with CRLF, and a wrong count (it is
    * skipped, not trusted). */
   points_of("late.pts", "# header\r\n\r\n  1000000 \r\n1 2 3\r\n", &p);
   check_points(&p, three, 1);
-  sc_points_free(&p);
+  scf_points_free(&p);
   /* Without a count line the first line is a point. */
   points_of("nocount.pts", "1 2 3 4\n", &p);
   check_points(&p, three, 1);
-  sc_points_free(&p);
+  scf_points_free(&p);
   /* Only the first line may be a count. */
   const char *path = tmp_path("twocounts.pts");
   write_text(path, "2\n1 2 3\n5\n");
   char msg[256];
-  CHECK_INT_EQ(sc_points_read(path, &p, msg, sizeof msg), SC_FILE_EFORMAT);
+  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
   CHECK_CONTAINS(msg, "line 3");
   /* Elsewhere a lone number is a bad line, not a count. */
   path = tmp_path("count.xyz");
   write_text(path, "1\n1 2 3\n");
-  CHECK_INT_EQ(sc_points_read(path, &p, msg, sizeof msg), SC_FILE_EFORMAT);
+  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
   CHECK_CONTAINS(msg, "line 1");
 }
 
 /* A .csv file may open with a line of column names. */
 static void test_csv(void) {
-  sc_points_t p;
+  scf_points_t p;
   points_of("head.csv", "x,y,z\n1,2,3\n-4.5,5e-3,6e10\n0.1,-0,9\n", &p);
   check_points(&p, three, 3);
-  sc_points_free(&p);
+  scf_points_free(&p);
   points_of("quoted.csv", "\"X\",\"Y\",\"Z\",\"intensity\"\r\n1,2,3,0.5\r\n",
             &p);
   check_points(&p, three, 1);
-  sc_points_free(&p);
+  scf_points_free(&p);
   points_of("nohead.csv", "1,2,3\n", &p);
   check_points(&p, three, 1);
-  sc_points_free(&p);
+  scf_points_free(&p);
   /* Only the first line may name columns. */
   const char *path = tmp_path("late.csv");
   write_text(path, "x,y,z\n1,2,3\nx,y,z\n");
   char msg[256];
-  CHECK_INT_EQ(sc_points_read(path, &p, msg, sizeof msg), SC_FILE_EFORMAT);
+  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
   CHECK_CONTAINS(msg, "line 3");
   CHECK_CONTAINS(msg, "'x'");
   /* Elsewhere a header is an error. */
   path = tmp_path("head.xyz");
   write_text(path, "x y z\n1 2 3\n");
-  CHECK_INT_EQ(sc_points_read(path, &p, msg, sizeof msg), SC_FILE_EFORMAT);
+  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
   CHECK_CONTAINS(msg, "line 1");
 }
 
@@ -133,7 +133,7 @@ static void test_no_points(void) {
   static const char *const texts[] = {"", "# nothing\n\n", "x,y,z\n",
                                       "# no vertices\nvt 0 0\n"};
   for (int i = 0; i < 4; i++) {
-    sc_points_t p;
+    scf_points_t p;
     points_of(names[i], texts[i], &p);
     CHECK_U64_EQ(p.count, 0);
     CHECK(p.xyz == NULL);
@@ -153,7 +153,7 @@ static void test_many_lines(void) {
     fprintf(f, "%d%s%.17g %d%s", i, i % 3 ? " " : ",\t", i * 0.001, -i,
             i % 7 ? "\n" : " 1 2 3 # extra\r\n");
   CHECK(fclose(f) == 0);
-  sc_points_t p;
+  scf_points_t p;
   read_ok(path, &p);
   CHECK_U64_EQ(p.count, N);
   for (int i = 0; i < N; i++) {
@@ -161,13 +161,13 @@ static void test_many_lines(void) {
     CHECK_DBL_SAME(p.xyz[3 * i + 1], i * 0.001);
     CHECK_DBL_SAME(p.xyz[3 * i + 2], (double)-i);
   }
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 static const double cube[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
                                   {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
 
-static void check_cube_points(const sc_points_t *p) {
+static void check_cube_points(const scf_points_t *p) {
   CHECK_U64_EQ(p->count, 8);
   for (int i = 0; i < 8; i++)
     for (int c = 0; c < 3; c++)
@@ -214,26 +214,26 @@ static void test_off(void) {
     snprintf(name, sizeof name, "cube%zu.%s", t, t % 2 ? "OFF" : "off");
     const char *path = tmp_path(name);
     write_text(path, texts[t]);
-    sc_points_t p;
+    scf_points_t p;
     read_ok(path, &p);
     check_cube_points(&p);
-    sc_points_free(&p);
+    scf_points_free(&p);
     uint32_t *tri;
     size_t nt;
     mesh_ok(path, &p, &tri, &nt);
     check_cube_points(&p);
     check_cube_tris(tri, nt);
     free(tri);
-    sc_points_free(&p);
+    scf_points_free(&p);
   }
   /* As points, the faces of an OFF file are never read: broken ones are
    * no obstacle. */
   const char *path = tmp_path("badfaces.off");
   write_text(path, "OFF\n3 1 0\n1 2 3\n1 2 3\n1 2 3\n3 0 1 99\n");
-  sc_points_t p;
+  scf_points_t p;
   read_ok(path, &p);
   CHECK_U64_EQ(p.count, 3);
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 static void test_obj(void) {
@@ -249,17 +249,17 @@ static void test_obj(void) {
                    "f -7/1/1 -6/1/1 -2/1/1 -3/1/1\r\n"
                    "f 3 4 8 7 # relative and absolute mixed below\r\n"
                    "f 4 -8 -4 -1");
-  sc_points_t p;
+  scf_points_t p;
   read_ok(path, &p);
   check_cube_points(&p);
-  sc_points_free(&p);
+  scf_points_free(&p);
   uint32_t *tri;
   size_t nt;
   mesh_ok(path, &p, &tri, &nt);
   check_cube_points(&p);
   check_cube_tris(tri, nt);
   free(tri);
-  sc_points_free(&p);
+  scf_points_free(&p);
 
   /* A face may name vertices that come later in the file. */
   path = tmp_path("forward.obj");
@@ -269,7 +269,7 @@ static void test_obj(void) {
   CHECK_U64_EQ(nt, 1);
   CHECK_U64_EQ(tri[2], 2);
   free(tri);
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 /* Binary STL data for two triangles with the given 80-byte header. */
@@ -296,7 +296,7 @@ static size_t stl_binary(unsigned char *out, const char *header) {
 static void check_stl(const char *path) {
   static const double want[6][3] = {{0, 0, 0},      {1, 0, 0},  {0, 1, 0},
                                     {0.5, 0.25, 0}, {-1, 0, 0}, {0, -2.5, 0}};
-  sc_points_t p;
+  scf_points_t p;
   uint32_t *tri;
   size_t nt;
   mesh_ok(path, &p, &tri, &nt);
@@ -308,7 +308,7 @@ static void check_stl(const char *path) {
   for (int i = 0; i < 6; i++)
     CHECK_U64_EQ(tri[i], i);
   free(tri);
-  sc_points_free(&p);
+  scf_points_free(&p);
 }
 
 static void test_stl(void) {

@@ -1,6 +1,9 @@
 /*
  * Point and mesh files: the one place that reads and writes PLY, XYZ-like
- * text, OFF, OBJ and STL, shared by the local command and the client.
+ * text, OFF, OBJ and STL, shared by the local command and the client. The
+ * module's public names start with scf_ (SCF_ for constants), to keep them
+ * apart from the core's sc_ names; the internals shared between its source
+ * files (scf_internal.h) start with scf__.
  *
  * Readers stream the file through a fixed buffer, so a file is never held in
  * memory whole, and they check every count a header declares against the
@@ -18,8 +21,8 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#ifndef SC_FILES_H
-#define SC_FILES_H
+#ifndef SHORTCRUST_FILES_H
+#define SHORTCRUST_FILES_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -33,7 +36,7 @@ extern "C" {
  * Error codes, in a range of their own (-101 to -106) so that a program can
  * report them next to the core's codes without confusing the two.
  */
-#define SC_FILE_ERRNO_MAP(X)                                                   \
+#define SCF_ERRNO_MAP(X)                                                       \
   X(INVAL, -101, "invalid argument")                                           \
   X(NOENT, -102, "no such file")                                               \
   X(IO, -103, "input/output error")                                            \
@@ -41,23 +44,23 @@ extern "C" {
   X(UNSUPPORTED, -105, "unsupported file format")                              \
   X(NOMEM, -106, "out of memory")
 
-typedef enum sc_file_err {
-  SC_FILE_OK = 0,
-#define SC_FILE_ERR_ENUM_(name, value, text) SC_FILE_E##name = (value),
-  SC_FILE_ERRNO_MAP(SC_FILE_ERR_ENUM_)
-#undef SC_FILE_ERR_ENUM_
-} sc_file_err_t;
+typedef enum scf_err {
+  SCF_OK = 0,
+#define SCF_ERR_ENUM_(name, value, text) SCF_E##name = (value),
+  SCF_ERRNO_MAP(SCF_ERR_ENUM_)
+#undef SCF_ERR_ENUM_
+} scf_err_t;
 
 /* A fixed English description of a code; "unknown error" for other values. */
-const char *sc_file_strerror(int code);
+const char *scf_strerror(int code);
 /* The code's name, e.g. "EFORMAT"; "UNKNOWN" for other values. */
-const char *sc_file_err_name(int code);
+const char *scf_err_name(int code);
 
 /* Points as 3 * count doubles (x, y, z of each point in turn). */
-typedef struct sc_points {
+typedef struct scf_points {
   double *xyz;
   size_t count;
-} sc_points_t;
+} scf_points_t;
 
 /*
  * Reads the points of a file into *out, choosing the format by the file's
@@ -80,14 +83,14 @@ typedef struct sc_points {
  * error. A file without points is not an error: count is 0 and xyz NULL.
  *
  * On success returns 0 and fills *out, which the caller releases with
- * sc_points_free(). On failure returns a negative SC_FILE_E* code, leaves
+ * scf_points_free(). On failure returns a negative SCF_E* code, leaves
  * *out zeroed, and writes a one-line message to msg (when msg_len > 0).
  */
-int sc_points_read(const char *path, sc_points_t *out, char *msg,
-                   size_t msg_len);
+int scf_points_read(const char *path, scf_points_t *out, char *msg,
+                    size_t msg_len);
 
 /* Releases the points and zeroes *p; accepts NULL and a zeroed struct. */
-void sc_points_free(sc_points_t *p);
+void scf_points_free(scf_points_t *p);
 
 /*
  * Reads a triangle mesh: vertices into *pts and 3 * *n_tri vertex indices
@@ -98,31 +101,31 @@ void sc_points_free(sc_points_t *p);
  * shared vertices, so each triangle gets three vertices of its own, in
  * file order). Polygons are split into a fan of triangles around their
  * first vertex. A file without faces gives *n_tri == 0 and *tri == NULL.
- * Failure as for sc_points_read(); *pts, *tri and *n_tri are then zeroed.
+ * Failure as for scf_points_read(); *pts, *tri and *n_tri are then zeroed.
  */
-int sc_mesh_read(const char *path, sc_points_t *pts, uint32_t **tri,
-                 size_t *n_tri, char *msg, size_t msg_len);
+int scf_mesh_read(const char *path, scf_points_t *pts, uint32_t **tri,
+                  size_t *n_tri, char *msg, size_t msg_len);
 
-/* Output formats of sc_mesh_write(). */
-typedef enum sc_mesh_format {
-  SC_MESH_FMT_AUTO = 0,   /* by the path's extension, binary PLY for .ply */
-  SC_MESH_FMT_PLY_BINARY, /* binary little-endian PLY */
-  SC_MESH_FMT_PLY_ASCII,
-  SC_MESH_FMT_OFF,
-  SC_MESH_FMT_OBJ,
-  SC_MESH_FMT_STL_BINARY,
-  SC_MESH_FMT_STL_ASCII
-} sc_mesh_format_t;
+/* Output formats of scf_mesh_write(). */
+typedef enum scf_mesh_format {
+  SCF_MESH_FMT_AUTO = 0,   /* by the path's extension, binary PLY for .ply */
+  SCF_MESH_FMT_PLY_BINARY, /* binary little-endian PLY */
+  SCF_MESH_FMT_PLY_ASCII,
+  SCF_MESH_FMT_OFF,
+  SCF_MESH_FMT_OBJ,
+  SCF_MESH_FMT_STL_BINARY,
+  SCF_MESH_FMT_STL_ASCII
+} scf_mesh_format_t;
 
 /*
  * The output format for a path's extension: .ply, .off, .obj or .stl (any
  * case). With ascii non-zero, .ply and .stl give their ascii variant; OFF
- * and OBJ are text in any case. Returns 0, or SC_FILE_EUNSUPPORTED with a
+ * and OBJ are text in any case. Returns 0, or SCF_EUNSUPPORTED with a
  * message naming the extension.
  */
-int sc_mesh_format_from_path(const char *path, int ascii,
-                             sc_mesh_format_t *fmt, char *msg,
-                             size_t msg_len);
+int scf_mesh_format_from_path(const char *path, int ascii,
+                              scf_mesh_format_t *fmt, char *msg,
+                              size_t msg_len);
 
 /*
  * Writes n_points vertices (xyz, 3 * n_points doubles) and n_tri triangles
@@ -137,31 +140,31 @@ int sc_mesh_format_from_path(const char *path, int ascii,
  * triangle, counter-clockwise meaning outward, and are zero for a triangle
  * without area.
  *
- * Returns 0, or a negative code with a message: SC_FILE_EINVAL for an index
- * not below n_points (nothing is written then), SC_FILE_EUNSUPPORTED for a
- * mesh the format cannot hold, SC_FILE_EIO when creating, writing, syncing
+ * Returns 0, or a negative code with a message: SCF_EINVAL for an index
+ * not below n_points (nothing is written then), SCF_EUNSUPPORTED for a
+ * mesh the format cannot hold, SCF_EIO when creating, writing, syncing
  * or renaming fails. On failure an existing file at path is left as it was
  * and the temporary file is removed.
  */
-int sc_mesh_write(const char *path, sc_mesh_format_t fmt, const double *xyz,
-                  size_t n_points, const uint32_t *tri, size_t n_tri,
-                  const double *normals, char *msg, size_t msg_len);
+int scf_mesh_write(const char *path, scf_mesh_format_t fmt, const double *xyz,
+                   size_t n_points, const uint32_t *tri, size_t n_tri,
+                   const double *normals, char *msg, size_t msg_len);
 
 /*
  * Replaces the file at path with len bytes of data, atomically in the same
- * way as sc_mesh_write() (for reports and other small outputs). A new file
+ * way as scf_mesh_write() (for reports and other small outputs). A new file
  * gets mode 0666 less the umask; a replaced file keeps its mode.
  */
-int sc_file_write_atomic(const char *path, const void *data, size_t len,
-                         char *msg, size_t msg_len);
+int scf_write_atomic(const char *path, const void *data, size_t len, char *msg,
+                     size_t msg_len);
 
-/* Writes s to f as a JSON string: quoted, with the quote and the backslash
- * escaped and control characters as \u00XX; NULL is written as "". For the
- * reports. */
-void sc_file_json_string(FILE *f, const char *s);
+/* Writes s to f as a JSON string, for reports beside the meshes: quoted,
+ * with the quote and the backslash escaped and control characters as
+ * \u00XX; NULL is written as "". */
+void scf_json_string(FILE *f, const char *s);
 
 #ifdef __cplusplus
 }
 #endif
 
-#endif /* SC_FILES_H */
+#endif /* SHORTCRUST_FILES_H */
