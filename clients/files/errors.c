@@ -30,7 +30,7 @@ const char *scf_err_name(int code) {
     return "OK";
 #define SCF_ERR_NAME_(name, value, text)                                       \
   case SCF_E##name:                                                            \
-    return "E" #name;
+    return #name;
     SCF_ERRNO_MAP(SCF_ERR_NAME_)
 #undef SCF_ERR_NAME_
   default:

@@ -697,12 +697,12 @@ static void test_codes(void) {
     const char *name, *text;
   } codes[] = {
       {SCF_OK, "OK", "success"},
-      {SCF_EINVAL, "EINVAL", "invalid argument"},
-      {SCF_ENOENT, "ENOENT", "no such file"},
-      {SCF_EIO, "EIO", "input/output error"},
-      {SCF_EFORMAT, "EFORMAT", "malformed file"},
-      {SCF_EUNSUPPORTED, "EUNSUPPORTED", "unsupported file format"},
-      {SCF_ENOMEM, "ENOMEM", "out of memory"},
+      {SCF_EINVAL, "INVAL", "invalid argument"},
+      {SCF_ENOENT, "NOENT", "no such file"},
+      {SCF_EIO, "IO", "input/output error"},
+      {SCF_EFORMAT, "FORMAT", "malformed file"},
+      {SCF_EUNSUPPORTED, "UNSUPPORTED", "unsupported file format"},
+      {SCF_ENOMEM, "NOMEM", "out of memory"},
   };
   for (size_t i = 0; i < sizeof codes / sizeof codes[0]; i++) {
     CHECK_STR_EQ(scf_err_name(codes[i].code), codes[i].name);
