@@ -53,7 +53,8 @@ typedef enum scf_err {
 
 /* A fixed English description of a code; "unknown error" for other values. */
 const char *scf_strerror(int code);
-/* The code's name, without the prefix, e.g. "FORMAT", as the other modules name theirs; "UNKNOWN" for other values. */
+/* The code's name without the prefix, e.g. "FORMAT", as the other modules
+ * name theirs; "UNKNOWN" for other values. */
 const char *scf_err_name(int code);
 
 /* Points as 3 * count doubles (x, y, z of each point in turn). */
