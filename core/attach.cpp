@@ -260,7 +260,8 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
       for (int k = 0; k < 3; ++k)
         q[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
       double d = dist2(p, q);
-      double longest = std::max(dist2(a, b), std::max(dist2(b, c), dist2(c, a)));
+      double longest =
+          std::max(dist2(a, b), std::max(dist2(b, c), dist2(c, a)));
       if (d < best && d <= longest) {
         best = d, bt = t;
         std::copy(w, w + 3, bw);

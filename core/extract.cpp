@@ -37,8 +37,8 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   auto edge_of = [&](uint32_t t, uint32_t x, uint32_t y) {
     const uint64_t key = edge_key(x, y);
     for (int j = 0; j < 3; ++j)
-      if (edge_key(live[3 * size_t(t) + j], live[3 * size_t(t) + (j + 1) % 3]) ==
-          key)
+      if (edge_key(live[3 * size_t(t) + j],
+                   live[3 * size_t(t) + (j + 1) % 3]) == key)
         return et.tri_edge[3 * size_t(t) + j];
     return uint32_t(UINT32_MAX);
   };
