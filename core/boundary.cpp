@@ -20,49 +20,22 @@ constexpr double kMaxCentreRatio2 = 8.0 * 8.0;
 // way it does where the surface ends.
 constexpr float kNearRatio2 = 3.0f * 3.0f;
 
-} // namespace
-
-// Boundary detection, after Dey and Giesen ("Detecting undersampling in
-// surface reconstruction", 2001). Where the surface is well sampled and
-// has no boundary, the Voronoi cell of a sample is long and thin along
-// the normal: everything of it inside the cocone is close to the sample
-// (r, the farthest Voronoi vertex in the cocone) compared with the
-// negative pole (h). At a boundary the cell opens up sideways, in the
-// tangent plane, and r grows to the size of the gap beyond the boundary
-// (to infinity on the convex hull). So:
-//  - ratio test: r <= rho h;
-//  - seeds: samples that pass it and whose pole agrees, within alpha
-//    (unoriented), with the pole of every cocone neighbour (a sample q
-//    sharing a Delaunay cell with s whose circumcentre lies in the cocone
-//    of s: the Voronoi facet between s and q then meets that cocone; we
-//    look only at Voronoi vertices, not at crossings of facet edges, which
-//    is what one pass over the cells gives);
-//  - growth: a neighbour that passes the ratio test and agrees with an
-//    interior sample becomes interior.
-// The rest are boundary samples.
+// On the hull the Voronoi cell is unbounded, in the directions of the
+// outward normals of the hull facets around the sample, and the pole is
+// their average, so the ratio test sees nothing of that part of the
+// cell. Where the surface goes on beyond a hull sample these normals
+// stay close together; where it ends there (the rim of a hemisphere or
+// of a scan, whose hull facets span the missing part) they fan out. So r
+// is infinite when two of them are more than (pi/2 - theta) / 2 apart:
+// the cell then opens up sideways, whatever the true normal is.
 template <class DT>
-void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
-              const sc_params_t &params, Progress &progress,
-              std::vector<uint8_t> &boundary, sc_diag_t &diag) {
+void open_hull_cells(DT &dt,
+                     const std::vector<typename DT::Cell_handle> &infinite,
+                     double cocone_theta) {
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
-  const double rho =
-      params.boundary_rho > 0 ? params.boundary_rho : kDefaultRho;
-  const double alpha =
-      params.boundary_alpha > 0 ? params.boundary_alpha : kDefaultAlpha;
-  const double sin2_c = Criteria(params).sin2_cocone;
-  const double cos_a = std::cos(alpha);
   const float kInf = std::numeric_limits<float>::infinity();
-
-  // On the hull the Voronoi cell is unbounded, in the directions of the
-  // outward normals of the hull facets around the sample, and the pole is
-  // their average, so the ratio test sees nothing of that part of the
-  // cell. Where the surface goes on beyond a hull sample these normals
-  // stay close together; where it ends there (the rim of a hemisphere or
-  // of a scan, whose hull facets span the missing part) they fan out. So r
-  // is infinite when two of them are more than (pi/2 - theta) / 2 apart:
-  // the cell then opens up sideways, whatever the true normal is.
-  const double cos_fan = std::cos((M_PI / 2 - params.cocone_theta) / 2);
+  const double cos_fan = std::cos((M_PI / 2 - cocone_theta) / 2);
   // One normal per hull facet, and per hull vertex the list of the
   // facet corners at it (sorting corners by vertex cost more than the
   // rest of this stage on small input, and a vector of (vertex, normal)
@@ -94,13 +67,16 @@ void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
         if (dot(hull[a / 3], hull[b / 3]) < cos_fan)
           v->info().r2 = kInf;
   }
-  hull = {};
-  next = {};
-  head = {};
+}
 
-  size_t cells = dt.number_of_cells(), k = 0;
-  // Per cell in the order visited: the links found below (2 bytes a
-  // cell, for the pass after the ratio test).
+// The ratio test's r and h, the nearest neighbours and the disagreeing
+// poles, from one pass over the cells; returns, per cell in the order
+// visited, the links that grow_interior() may follow (2 bytes a cell).
+template <class DT>
+std::vector<uint16_t> measure_cells(DT &dt, double sin2_c, double cos_a,
+                                    Progress &progress) {
+  const size_t cells = dt.number_of_cells();
+  size_t k = 0;
   std::vector<uint16_t> cell_links(cells);
   V3 pole[4];
   bool in_cone[4], grow_cone[4];
@@ -162,16 +138,15 @@ void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
     cell_links[k - 1] = links;
   });
 
-  // Growth from agreeing neighbours: a sample that passes the ratio test
-  // becomes interior when a cell around it whose circumcentre lies in the
-  // cocone of an interior neighbour joins it to that neighbour with poles
-  // that agree, until nothing changes. Only the samples that pass the
-  // ratio test but whose poles disagree (waiting) can change, so only the
-  // cells around them are looked at below, instead of the star of every
-  // interior sample.
-  std::vector<Vh> waiting;
-  const size_t m = dt.number_of_vertices();
-  std::vector<uint8_t> state(m, 0); // by vertex number: 1 interior, 2 waiting
+  return cell_links;
+}
+
+// Marks the samples that pass the ratio test (kVRatio). Those whose poles
+// agree with every cocone neighbour's are the seeds, interior (state 1);
+// the others that pass wait (state 2, and listed in waiting).
+template <class DT>
+void ratio_test(DT &dt, double rho, std::vector<uint8_t> &state,
+                std::vector<typename DT::Vertex_handle> &waiting) {
   const float rho2 = float(rho * rho);
   for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end();
        ++v) {
@@ -189,6 +164,21 @@ void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
       state[d.idx] = 2;
     }
   }
+}
+
+// Growth from agreeing neighbours: a sample that passes the ratio test
+// becomes interior when a cell around it whose circumcentre lies in the
+// cocone of an interior neighbour joins it to that neighbour with poles
+// that agree, until nothing changes. Only the samples that pass the
+// ratio test but whose poles disagree (waiting) can change, so only the
+// cells around them are looked at below, instead of the star of every
+// interior sample.
+// Makes interior (state 1) the waiting samples that the links reach from
+// an interior one; frees cell_links.
+template <class DT>
+void grow_interior(DT &dt, std::vector<uint16_t> &cell_links,
+                   std::vector<uint8_t> &state, Progress &progress) {
+  const size_t m = dt.number_of_vertices();
   // The links along which a waiting sample q can become interior: from a
   // neighbour v that passes the ratio test, through a cell whose
   // circumcentre is in v's cocone, when their poles agree. One pass over
@@ -200,7 +190,8 @@ void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
   // kept of 1.8 million, 7 MB of fresh memory instead of 28).
   std::vector<std::pair<uint32_t, uint32_t>> links;
   std::vector<uint32_t> grown;
-  k = 0;
+  const size_t cells = dt.number_of_cells();
+  size_t k = 0;
   for_cells(dt, false, [&](auto c) {
     const uint16_t mask = cell_links[k];
     progress.tick(cells + k++, 2 * cells);
@@ -249,6 +240,48 @@ void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
         grown.push_back(to[i]);
       }
   }
+}
+
+} // namespace
+
+// Boundary detection, after Dey and Giesen ("Detecting undersampling in
+// surface reconstruction", 2001). Where the surface is well sampled and
+// has no boundary, the Voronoi cell of a sample is long and thin along
+// the normal: everything of it inside the cocone is close to the sample
+// (r, the farthest Voronoi vertex in the cocone) compared with the
+// negative pole (h). At a boundary the cell opens up sideways, in the
+// tangent plane, and r grows to the size of the gap beyond the boundary
+// (to infinity on the convex hull). So:
+//  - ratio test: r <= rho h;
+//  - seeds: samples that pass it and whose pole agrees, within alpha
+//    (unoriented), with the pole of every cocone neighbour (a sample q
+//    sharing a Delaunay cell with s whose circumcentre lies in the cocone
+//    of s: the Voronoi facet between s and q then meets that cocone; we
+//    look only at Voronoi vertices, not at crossings of facet edges, which
+//    is what one pass over the cells gives);
+//  - growth: a neighbour that passes the ratio test and agrees with an
+//    interior sample becomes interior.
+// The rest are boundary samples.
+template <class DT>
+void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
+              const sc_params_t &params, Progress &progress,
+              std::vector<uint8_t> &boundary, sc_diag_t &diag) {
+  typedef typename DT::Vertex_handle Vh;
+  const double rho =
+      params.boundary_rho > 0 ? params.boundary_rho : kDefaultRho;
+  const double alpha =
+      params.boundary_alpha > 0 ? params.boundary_alpha : kDefaultAlpha;
+  const double sin2_c = Criteria(params).sin2_cocone;
+  const double cos_a = std::cos(alpha);
+
+  open_hull_cells(dt, infinite, params.cocone_theta);
+  std::vector<uint16_t> cell_links =
+      measure_cells(dt, sin2_c, cos_a, progress);
+  std::vector<Vh> waiting;
+  const size_t m = dt.number_of_vertices();
+  std::vector<uint8_t> state(m, 0); // by vertex number: 1 interior, 2 waiting
+  ratio_test(dt, rho, state, waiting);
+  grow_interior(dt, cell_links, state, progress);
   for (Vh q : waiting)
     if (state[q->info().idx] == 1)
       q->info().flags |= kVInterior;
