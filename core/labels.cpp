@@ -38,11 +38,10 @@ public:
   bool label_and_close(std::vector<uint32_t> &tris, Progress &progress,
                        sc_diag_t &diag) {
     const size_t m = dt_.number_of_vertices();
-    std::vector<Vh> &vh = vh_;
-    vh.assign(m, Vh());
+    vh_.assign(m, Vh());
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v)
-      vh[v->info().idx] = v;
+      vh_[v->info().idx] = v;
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
       c->info().w = CellLabel{0, 0, 0, kUnlabelled, 0, 0};
 
@@ -53,12 +52,36 @@ public:
     std::vector<Ch> fc(nt);
     std::vector<int8_t> fi(nt, -1);
     std::vector<int8_t> hull_vote(nt, 0);
+    find_facets(tris, progress, fc, fi, hull_vote);
+    flip_inward_components(tris, hull_vote);
+
+    std::vector<Ch> queue = seed(tris, fc, fi);
+    progress.tick(nt, 4 * nt + 1);
+    spread(std::move(queue));
+    progress.tick(2 * nt, 4 * nt + 1);
+    repair(diag);
+    progress.tick(3 * nt, 4 * nt + 1);
+    std::vector<uint32_t> res = boundary_of_inside();
+    if (res.empty())
+      return false;
+    tris.swap(res);
+    return true;
+  }
+
+private:
+  // The Delaunay facet of each surface triangle t, as cell fc[t] and its
+  // facet fi[t] (-1 for a triangle that is not a facet), and the vote of
+  // each hull triangle on its orientation (see flip_inward_components()).
+  void find_facets(const std::vector<uint32_t> &tris, Progress &progress,
+                   std::vector<Ch> &fc, std::vector<int8_t> &fi,
+                   std::vector<int8_t> &hull_vote) {
+    const size_t nt = tris.size() / 3;
     for (size_t t = 0; t < nt; ++t) {
       progress.tick(t, 4 * nt + 1);
       const uint32_t *v = &tris[3 * t];
       int i, j, l;
       Ch c;
-      if (!dt_.is_facet(vh[v[0]], vh[v[1]], vh[v[2]], c, i, j, l))
+      if (!dt_.is_facet(vh_[v[0]], vh_[v[1]], vh_[v[2]], c, i, j, l))
         continue; // a hole-filling triangle: not a Delaunay facet
       int f = 6 - i - j - l;
       fc[t] = c;
@@ -70,8 +93,15 @@ public:
       else if (dt_.is_infinite(nb))
         hull_vote[t] = c_front ? -1 : 1;
     }
-    flip_inward_components(tris, hull_vote);
+  }
 
+  // The seeds: the votes of the surface triangles on the cells on either
+  // side of them, which they also bar from each other; returns the cells
+  // labelled, infinite ones included.
+  std::vector<Ch> seed(const std::vector<uint32_t> &tris,
+                       const std::vector<Ch> &fc,
+                       const std::vector<int8_t> &fi) {
+    const size_t nt = tris.size() / 3;
     std::vector<Ch> queue;
     for (size_t t = 0; t < nt; ++t) {
       if (fi[t] < 0)
@@ -92,11 +122,15 @@ public:
       if (w.label != kUnlabelled)
         queue.push_back(c);
     }
-    progress.tick(nt, 4 * nt + 1);
-    // Level by level, so that the result does not depend on the order of
-    // the cells in memory: a cell reached from the last level takes the
-    // label of most of its neighbours there (outside on a tie), counted in
-    // w.local (inside in the high half).
+    return queue;
+  }
+
+  // Labels the rest from the cells in queue, across every facet that is not
+  // a surface triangle. Level by level, so that the result does not depend
+  // on the order of the cells in memory: a cell reached from the last level
+  // takes the label of most of its neighbours there (outside on a tie),
+  // counted in w.local (inside in the high half).
+  void spread(std::vector<Ch> queue) {
     std::vector<Ch> next;
     while (!queue.empty()) {
       next.clear();
@@ -120,11 +154,12 @@ public:
       }
       queue.swap(next);
     }
-    queue = std::vector<Ch>();
-    progress.tick(2 * nt, 4 * nt + 1);
+  }
 
-    // Repair. Only vertices with cells of both labels around them can be
-    // pinched.
+  // Repairs the pinches of the inside cells' boundary (see repair_vertex()).
+  // Only vertices with cells of both labels around them can be pinched.
+  void repair(sc_diag_t &diag) {
+    const size_t m = vh_.size();
     std::vector<uint8_t> seen(m, 0);
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c)
       for (int j = 0; j < 4; ++j)
@@ -138,7 +173,7 @@ public:
     std::vector<uint8_t> queued(m, 0);
     for (size_t i = 0; i < m; ++i)
       if (seen[i] == (kInside | kOutside)) {
-        work.push_back(vh[i]);
+        work.push_back(vh_[i]);
         queued[i] = 1;
       }
     const uint64_t budget = 64 * uint64_t(work.size()) + 10000;
@@ -177,9 +212,11 @@ public:
           }
       }
     }
-    progress.tick(3 * nt, 4 * nt + 1);
     (void)gave_up;
+  }
 
+  // The boundary of the inside cells, each triangle facing out of them.
+  std::vector<uint32_t> boundary_of_inside() const {
     std::vector<uint32_t> res;
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
       if (c->info().w.label != kInside)
@@ -196,10 +233,7 @@ public:
         res.insert(res.end(), t, t + 3);
       }
     }
-    if (res.empty())
-      return false;
-    tris.swap(res);
-    return true;
+    return res;
   }
 
   // The vertex numbers of a cell, ascending (the infinite vertex last): a
