@@ -34,15 +34,80 @@ bool is_triangle_of(const EdgeTable &et, const std::vector<uint32_t> &tris,
   return false;
 }
 
+// Each vertex's neighbours along the surface's edges, and along the chords
+// added by earlier fills, which count as existing edges too: two holes that
+// share vertices must not both add the same chord. A chord is two links,
+// one in the list of each end, so that the chords of a hole that cannot be
+// filled come off again in reverse.
+class Neighbours {
+public:
+  Neighbours(size_t n, const EdgeTable &et)
+      : adj_first_(n + 1, 0), adj_(2 * et.edges()) {
+    for (size_t e = 0; e < et.edges(); ++e) {
+      const uint64_t k = et.entries[et.first[e]].key;
+      ++adj_first_[key_lo(k) + 1];
+      ++adj_first_[uint32_t(k) + 1];
+    }
+    for (size_t v = 0; v < n; ++v)
+      adj_first_[v + 1] += adj_first_[v];
+    {
+      std::vector<uint32_t> fill(adj_first_.begin(), adj_first_.end() - 1);
+      for (size_t e = 0; e < et.edges(); ++e) {
+        const uint64_t k = et.entries[et.first[e]].key;
+        adj_[fill[key_lo(k)]++] = uint32_t(k);
+        adj_[fill[uint32_t(k)]++] = key_lo(k);
+      }
+    }
+    chord_head_.assign(n, UINT32_MAX);
+  }
+
+  void add_chord(uint64_t k) {
+    const uint32_t a = key_lo(k), b = uint32_t(k);
+    links_.push_back({b, chord_head_[a]});
+    chord_head_[a] = uint32_t(links_.size() - 1);
+    links_.push_back({a, chord_head_[b]});
+    chord_head_[b] = uint32_t(links_.size() - 1);
+  }
+  // Where the chords stand now, for drop_chords_to().
+  size_t mark() const { return links_.size(); }
+  // Takes off the chords added since mark() gave `mark`.
+  void drop_chords_to(size_t mark) {
+    for (; links_.size() > mark; links_.resize(links_.size() - 2)) {
+      const size_t i = links_.size() - 2;
+      chord_head_[links_[i + 1].other] = links_[i].next;
+      chord_head_[links_[i].other] = links_[i + 1].next;
+    }
+  }
+  // Calls visit(w) on every vertex w joined to a by an edge or a chord.
+  template <class Visit> void for_each(uint32_t a, Visit &&visit) const {
+    for (uint32_t i = adj_first_[a]; i < adj_first_[a + 1]; ++i)
+      visit(adj_[i]);
+    for (uint32_t i = chord_head_[a]; i != UINT32_MAX; i = links_[i].next)
+      visit(links_[i].other);
+  }
+  bool has_edge(uint32_t a, uint32_t b) const {
+    bool joined = false;
+    for_each(a, [&](uint32_t w) { joined = joined || w == b; });
+    return joined;
+  }
+
+private:
+  struct Link {
+    uint32_t other, next;
+  };
+  std::vector<uint32_t> adj_first_, adj_;
+  std::vector<uint32_t> chord_head_;
+  std::vector<Link> links_;
+};
+
 // Patches the loop (vertex numbers in order; the hole runs along it) with
 // the triangulation of least total area whose chords are all new edges, and
 // appends its triangles to res and its chords to `chords`. The edge from the
-// last vertex back to the first is part of the loop. for_neighbours(v, f)
-// calls f on every vertex joined to v by an edge; pos is scratch, n entries
+// last vertex back to the first is part of the loop. nb tells the vertices
+// joined to each by an edge; pos is scratch, n entries
 // of UINT32_MAX, left so. Returns false when no such triangulation exists.
-template <class ForNeighbours>
 bool patch(const double *xyz, const std::vector<uint32_t> &loop,
-           ForNeighbours for_neighbours, std::vector<uint32_t> &pos,
+           const Neighbours &nb, std::vector<uint32_t> &pos,
            std::vector<uint8_t> &joined, std::vector<double> &cost,
            std::vector<double> &costT, std::vector<uint32_t> &split,
            std::vector<uint32_t> &res, std::vector<uint64_t> &chords) {
@@ -53,7 +118,7 @@ bool patch(const double *xyz, const std::vector<uint32_t> &loop,
     pos[loop[i]] = uint32_t(i);
   joined.assign(L * L, 0);
   for (size_t i = 0; i < L; ++i)
-    for_neighbours(loop[i], [&](uint32_t w) {
+    nb.for_each(loop[i], [&](uint32_t w) {
       if (pos[w] != UINT32_MAX)
         joined[i * L + pos[w]] = 1;
     });
@@ -132,9 +197,8 @@ bool patch(const double *xyz, const std::vector<uint32_t> &loop,
 // the loop apart: `loop` keeps the part from one end of the chord to the
 // other, `rest` gets the other part; both then end with the chord. Returns
 // false when every such chord is an edge already.
-template <class HasEdge>
 bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
-              std::vector<uint32_t> &rest, HasEdge has_edge) {
+              std::vector<uint32_t> &rest, const Neighbours &nb) {
   const size_t L = loop.size(), half = L / 2, window = L / 8;
   double best = std::numeric_limits<double>::infinity();
   size_t bi = 0, bj = 0;
@@ -158,7 +222,7 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
         if (d2 < best) {
           const size_t jj = j < L ? j : j - L;
           if (loop[i] != loop[jj] &&
-              (!new_only || !has_edge(loop[i], loop[jj])))
+              (!new_only || !nb.has_edge(loop[i], loop[jj])))
             best = d2, bi = i, bj = jj;
         }
       }
@@ -170,7 +234,7 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
   // search's time. Only if it is an edge already is the search run again.
   shortest(false);
   if (best < std::numeric_limits<double>::infinity() &&
-      has_edge(loop[bi], loop[bj]))
+      nb.has_edge(loop[bi], loop[bj]))
     shortest(true);
   if (!(best < std::numeric_limits<double>::infinity()))
     return false;
@@ -187,80 +251,12 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
   return true;
 }
 
-} // namespace
-
-// Closes the holes of an edge-manifold, consistently oriented, vertex-
-// manifold surface whose boundary loops have at most max_loop edges. Each
-// hole is triangulated over its own loop by dynamic programming for the
-// least total area, never creating an edge the surface already has, so the
-// result stays a manifold.
-void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
-                size_t max_loop, const std::vector<uint8_t> &boundary,
-                Progress &progress, sc_diag_t &diag, uint64_t max_work,
-                EdgeTable *table) {
-  // (Built only when needed: a table takes the pools' largest arrays.)
-  std::unique_ptr<EdgeTable> own;
-  if (!table) {
-    own.reset(new EdgeTable);
-    table = own.get();
-  }
-  if (table->first.empty())
-    table->build(xyz, n, res, progress, false);
-  if (res.empty())
-    return;
-  const EdgeTable &et = *table;
-  const size_t unfilled = res.size() / 3;
-  // Each vertex's neighbours along the surface's edges ...
-  std::vector<uint32_t> adj_first(n + 1, 0), adj(2 * et.edges());
-  for (size_t e = 0; e < et.edges(); ++e) {
-    const uint64_t k = et.entries[et.first[e]].key;
-    ++adj_first[key_lo(k) + 1];
-    ++adj_first[uint32_t(k) + 1];
-  }
-  for (size_t v = 0; v < n; ++v)
-    adj_first[v + 1] += adj_first[v];
-  {
-    std::vector<uint32_t> fill(adj_first.begin(), adj_first.end() - 1);
-    for (size_t e = 0; e < et.edges(); ++e) {
-      const uint64_t k = et.entries[et.first[e]].key;
-      adj[fill[key_lo(k)]++] = uint32_t(k);
-      adj[fill[uint32_t(k)]++] = key_lo(k);
-    }
-  }
-  // ... and along the chords added by earlier fills, which count as
-  // existing edges too: two holes that share vertices must not both add the
-  // same chord. A chord is two links, one in the list of each end, so that
-  // the chords of a hole that cannot be filled come off again in reverse.
-  struct Link {
-    uint32_t other, next;
-  };
-  std::vector<uint32_t> chord_head(n, UINT32_MAX);
-  std::vector<Link> links;
-  auto add_chord = [&](uint64_t k) {
-    const uint32_t a = key_lo(k), b = uint32_t(k);
-    links.push_back({b, chord_head[a]});
-    chord_head[a] = uint32_t(links.size() - 1);
-    links.push_back({a, chord_head[b]});
-    chord_head[b] = uint32_t(links.size() - 1);
-  };
-  auto drop_chords_to = [&](size_t mark) {
-    for (; links.size() > mark; links.resize(links.size() - 2)) {
-      const size_t i = links.size() - 2;
-      chord_head[links[i + 1].other] = links[i].next;
-      chord_head[links[i].other] = links[i + 1].next;
-    }
-  };
-  auto for_neighbours = [&](uint32_t a, auto &&visit) {
-    for (uint32_t i = adj_first[a]; i < adj_first[a + 1]; ++i)
-      visit(adj[i]);
-    for (uint32_t i = chord_head[a]; i != UINT32_MAX; i = links[i].next)
-      visit(links[i].other);
-  };
-  auto has_edge = [&](uint32_t a, uint32_t b) {
-    bool joined = false;
-    for_neighbours(a, [&](uint32_t w) { joined = joined || w == b; });
-    return joined;
-  };
+// The loops of the surface's holes that are to be filled, shortest first:
+// each a loop of at most max_loop edges (vertex numbers in order; the hole
+// runs along it), and not where the surface ends (see below).
+std::vector<std::vector<uint32_t>>
+holes_to_fill(size_t n, const EdgeTable &et, const std::vector<uint32_t> &res,
+              size_t max_loop, const std::vector<uint8_t> &boundary) {
   // The hole runs against the orientation of the triangle on each boundary
   // edge: a triangle with x -> y leaves the hole edge y -> x.
   std::vector<uint32_t> next(n, UINT32_MAX);
@@ -280,10 +276,8 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
     }
   }
   std::vector<uint32_t> loop;
-  std::vector<std::vector<uint32_t>> loops, pieces;
-  std::vector<double> cost, costT;
-  std::vector<uint32_t> split, pos(n, UINT32_MAX);
-  std::vector<uint8_t> joined, seen(n, 0);
+  std::vector<std::vector<uint32_t>> loops;
+  std::vector<uint8_t> seen(n, 0);
   for (uint32_t v0 = 0; v0 < n; ++v0) {
     if (next[v0] == UINT32_MAX || seen[v0])
       continue;
@@ -329,44 +323,96 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
                       const std::vector<uint32_t> &b) {
                      return a.size() < b.size();
                    });
-  for (const std::vector<uint32_t> &hole : loops) {
-    // A long loop is first cut by short chords into pieces of at most
-    // kMaxPatch edges; the pieces are patched one by one, and the hole is
-    // filled only if all of them are.
-    pieces.assign(1, hole);
-    const size_t mark = links.size();
-    bool cut_ok = true;
-    for (size_t p = 0; p < pieces.size() && cut_ok; ++p) {
-      while (pieces[p].size() > kMaxPatch) {
-        std::vector<uint32_t> rest;
-        if (!cut_loop(xyz, pieces[p], rest, has_edge)) {
-          cut_ok = false;
-          break;
-        }
-        const std::vector<uint32_t> &q = pieces[p];
-        add_chord(edge_key(q.front(), q.back()));
-        pieces.push_back(std::move(rest));
+  return loops;
+}
+
+// The scratch of the patches, kept from one hole to the next; pos holds
+// n entries of UINT32_MAX between patches.
+struct PatchScratch {
+  std::vector<std::vector<uint32_t>> pieces;
+  std::vector<double> cost, costT;
+  std::vector<uint32_t> split, pos;
+  std::vector<uint8_t> joined;
+  explicit PatchScratch(size_t n) : pos(n, UINT32_MAX) {}
+};
+
+// Fills one hole, within max_work steps of the dynamic programme (less the
+// steps taken on return): a long loop is first cut by short chords into
+// pieces of at most kMaxPatch edges; the pieces are patched one by one, and
+// the hole is filled only if all of them are. Otherwise res and the chords
+// are left as they were, and returns false.
+bool fill_hole(const double *xyz, const std::vector<uint32_t> &hole,
+               Neighbours &nb, PatchScratch &scratch, uint64_t &max_work,
+               std::vector<uint32_t> &res) {
+  std::vector<std::vector<uint32_t>> &pieces = scratch.pieces;
+  pieces.assign(1, hole);
+  const size_t mark = nb.mark();
+  bool cut_ok = true;
+  for (size_t p = 0; p < pieces.size() && cut_ok; ++p) {
+    while (pieces[p].size() > kMaxPatch) {
+      std::vector<uint32_t> rest;
+      if (!cut_loop(xyz, pieces[p], rest, nb)) {
+        cut_ok = false;
+        break;
       }
+      const std::vector<uint32_t> &q = pieces[p];
+      nb.add_chord(edge_key(q.front(), q.back()));
+      pieces.push_back(std::move(rest));
     }
-    uint64_t work = 0;
-    for (const auto &q : pieces)
-      work += uint64_t(q.size()) * q.size() * q.size() / 6;
+  }
+  uint64_t work = 0;
+  for (const auto &q : pieces)
+    work += uint64_t(q.size()) * q.size() * q.size() / 6;
+  const size_t before = res.size();
+  std::vector<uint64_t> added_chords;
+  bool ok_all = cut_ok && work <= max_work;
+  for (size_t p = 0; p < pieces.size() && ok_all; ++p)
+    ok_all = patch(xyz, pieces[p], nb, scratch.pos, scratch.joined,
+                   scratch.cost, scratch.costT, scratch.split, res,
+                   added_chords);
+  if (!ok_all) {
+    // Not all pieces could be patched: leave the hole as it was.
+    res.resize(before);
+    nb.drop_chords_to(mark);
+    return false;
+  }
+  max_work -= work;
+  for (uint64_t k : added_chords)
+    nb.add_chord(k);
+  return true;
+}
+
+} // namespace
+
+// Closes the holes of an edge-manifold, consistently oriented, vertex-
+// manifold surface whose boundary loops have at most max_loop edges. Each
+// hole is triangulated over its own loop by dynamic programming for the
+// least total area, never creating an edge the surface already has, so the
+// result stays a manifold.
+void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
+                size_t max_loop, const std::vector<uint8_t> &boundary,
+                Progress &progress, sc_diag_t &diag, uint64_t max_work,
+                EdgeTable *table) {
+  // (Built only when needed: a table takes the pools' largest arrays.)
+  std::unique_ptr<EdgeTable> own;
+  if (!table) {
+    own.reset(new EdgeTable);
+    table = own.get();
+  }
+  if (table->first.empty())
+    table->build(xyz, n, res, progress, false);
+  if (res.empty())
+    return;
+  const EdgeTable &et = *table;
+  const size_t unfilled = res.size() / 3;
+  Neighbours nb(n, et);
+  const std::vector<std::vector<uint32_t>> loops =
+      holes_to_fill(n, et, res, max_loop, boundary);
+  PatchScratch scratch(n);
+  for (const std::vector<uint32_t> &hole : loops) {
     const size_t before = res.size();
-    std::vector<uint64_t> added_chords;
-    bool ok_all = cut_ok && work <= max_work;
-    for (size_t p = 0; p < pieces.size() && ok_all; ++p)
-      ok_all = patch(xyz, pieces[p], for_neighbours, pos, joined, cost, costT,
-                     split, res, added_chords);
-    if (ok_all) {
-      max_work -= work;
-      for (uint64_t k : added_chords)
-        add_chord(k);
-    } else {
-      // Not all pieces could be patched: leave the hole as it was.
-      res.resize(before);
-      drop_chords_to(mark);
+    if (!fill_hole(xyz, hole, nb, scratch, max_work, res))
       continue;
-    }
     const size_t added = (res.size() - before) / 3;
     ++diag.holes_filled;
     diag.hole_triangles += added;
