@@ -34,6 +34,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 namespace sc {
@@ -106,6 +107,12 @@ typedef CGAL::Delaunay_triangulation_3<K, TdsSeq> DtSeq;
 // Cells are most of the memory of a reconstruction: a byte more in
 // CellData makes them 88 bytes, and the peak 8% higher.
 static_assert(sizeof(TdsSeq::Cell) <= 80, "a cell grew beyond 80 bytes");
+// CGAL_ALLOCATOR above reached the containers of cells and vertices.
+static_assert(std::is_same<TdsSeq::Cell_range::allocator_type,
+                           PrefaultAllocator<TdsSeq::Cell>>::value &&
+                  std::is_same<TdsSeq::Vertex_range::allocator_type,
+                               PrefaultAllocator<TdsSeq::Vertex>>::value,
+              "the triangulation's blocks bypass PrefaultAllocator");
 #ifdef CGAL_LINKED_WITH_TBB
 typedef CGAL::Triangulation_data_structure_3<Vb, Cb, CGAL::Parallel_tag>
     TdsPar;
