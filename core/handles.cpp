@@ -105,14 +105,13 @@ struct Region {
   }
 };
 
-} // namespace
-
-size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
-                   Progress &progress, EdgeTable &table) {
+// Grows the region over each component of tris, nearest first from the
+// component's first triangle, so that the fronts meet on the far side of
+// each handle from where they came; the region takes every triangle that
+// does not join two of its boundary loops (raise its genus).
+void grow_region(const double *xyz, const std::vector<uint32_t> &tris,
+                 Region &reg, Progress &progress) {
   const size_t nt = tris.size() / 3;
-  if (nt == 0)
-    return 0;
-  Region reg(n, tris, progress, table);
   // What the growth below reads of a triangle when it reaches it, side by
   // side: its centre and the least distance to it so far. (In arrays of
   // their own, each was a cache miss of its own.)
@@ -138,10 +137,8 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
     return std::sqrt(s);
   };
 
-  // Nearest first from each component's first triangle, so that the fronts
-  // meet on the far side of each handle from where they came. A triangle
-  // is seen once taken off the queue (kSeen in reg.in, beside kIn, until
-  // the growth ends).
+  // A triangle is seen once taken off the queue (kSeen in reg.in, beside
+  // kIn, until the growth ends).
   using Item = std::pair<double, uint32_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
   size_t done = 0;
@@ -180,19 +177,29 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   reach = std::vector<Reach>();
   for (uint8_t &f : reg.in) // what follows reads in as in or out
     f &= kIn;
-  // The surface is a manifold: only where the region left triangles out
-  // can a vertex have several fans in it.
-  fix_fans(n, tris, reg.in, true);
+}
 
-  // The cuts: triangles left out, in groups that share vertices.
-  std::vector<uint32_t> group(n);
-  for (uint32_t v = 0; v < n; ++v)
-    group[v] = v;
-  auto find = [&](uint32_t v) {
+// The cuts: the triangles the region left out, in groups that share
+// vertices, and what each group's cut opens.
+struct Cuts {
+  std::vector<uint32_t> group; // per vertex: union-find over the cuts
+  // Per group (its root vertex): the edges cut and the hole edges on the
+  // loops it opens, and the longest hole among them.
+  std::vector<uint64_t> cut_edges, hole_edges, longest_hole;
+
+  uint32_t find(uint32_t v) {
     while (group[v] != v)
       v = group[v] = group[group[v]];
     return v;
-  };
+  }
+  Cuts(size_t n, const std::vector<uint32_t> &tris, const Region &reg);
+};
+
+Cuts::Cuts(size_t n, const std::vector<uint32_t> &tris, const Region &reg)
+    : group(n) {
+  const size_t nt = tris.size() / 3;
+  for (uint32_t v = 0; v < n; ++v)
+    group[v] = v;
   std::vector<uint8_t> cut_vertex(n, 0);
   for (size_t t = 0; t < nt; ++t) {
     if (reg.in[t])
@@ -209,7 +216,9 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   // is longer than the cut; a true handle, such as a cat's tail, is cut
   // across sampled surface, far from any hole or past holes shorter than
   // the cut. Cuts of the second kind are put back.
-  std::vector<uint64_t> cut_edges(n, 0), hole_edges(n, 0), longest_hole(n, 0);
+  cut_edges.assign(n, 0);
+  hole_edges.assign(n, 0);
+  longest_hole.assign(n, 0);
   // The length of the hole each boundary half-edge of the surface is on
   // (turning about vertices through every triangle, not just the region's).
   std::vector<uint32_t> hole_len(tris.size(), 0), on_hole;
@@ -250,15 +259,32 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
       longest_hole[c] = std::max(longest_hole[c], longest);
     }
   }
+}
+
+} // namespace
+
+size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
+                   Progress &progress, EdgeTable &table) {
+  const size_t nt = tris.size() / 3;
+  if (nt == 0)
+    return 0;
+  Region reg(n, tris, progress, table);
+  grow_region(xyz, tris, reg, progress);
+  // The surface is a manifold: only where the region left triangles out
+  // can a vertex have several fans in it.
+  fix_fans(n, tris, reg.in, true);
+
+  Cuts groups(n, tris, reg);
   std::vector<uint8_t> counted(n, 0);
   size_t cuts = 0;
   std::vector<uint32_t> kept;
   kept.reserve(tris.size());
   std::vector<uint8_t> keep(nt, 1);
   for (size_t t = 0; t < nt; ++t) {
-    const uint32_t c = find(tris[3 * t]);
-    if (reg.in[t] || cut_edges[c] > kMaxCutPerHoleEdge * hole_edges[c] ||
-        longest_hole[c] < kMinHolePerCutEdge * cut_edges[c]) {
+    const uint32_t c = groups.find(tris[3 * t]);
+    if (reg.in[t] ||
+        groups.cut_edges[c] > kMaxCutPerHoleEdge * groups.hole_edges[c] ||
+        groups.longest_hole[c] < kMinHolePerCutEdge * groups.cut_edges[c]) {
       kept.insert(kept.end(), &tris[3 * t], &tris[3 * t] + 3);
       continue;
     }

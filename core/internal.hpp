@@ -127,7 +127,8 @@ public:
 std::unique_ptr<Triangulator> make_triangulator(int threads,
                                                 const double *bbox6);
 
-// Pruning and manifold extraction over the candidates (surface.cpp).
+// Pruning and manifold extraction over the candidates (prune.cpp,
+// extract.cpp).
 // Returns the oriented output triangles and fills the output diagnostics.
 struct Surface {
   std::vector<uint32_t> tris;
@@ -158,7 +159,7 @@ struct Surface {
   }
 };
 // The candidates' edges with their triangles in order about each edge
-// (surface.cpp): pruning builds it, extraction takes it over.
+// (edges.hpp): pruning builds it, extraction takes it over.
 struct EdgeTable;
 struct EdgeTableFree {
   void operator()(EdgeTable *et) const;
@@ -167,7 +168,7 @@ typedef std::unique_ptr<EdgeTable, EdgeTableFree> EdgeTablePtr;
 // An empty table, for fill_holes() to leave the table of its result in.
 EdgeTablePtr new_edge_table();
 // Frees the arrays that this thread's edge tables and vertex stars keep
-// for reuse (surface.cpp); called at the end of each reconstruction.
+// for reuse (edges.cpp); called at the end of each reconstruction.
 void release_scratch();
 // Sharp-edge pruning (section 7). keep_vertex, when not empty, marks the
 // vertices at which no edge is ever sharp (boundary samples). Leaves the

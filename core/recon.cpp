@@ -263,6 +263,106 @@ void Recon::borrow(const double *xyz, size_t n) {
   insert_range(0, n);
 }
 
+namespace {
+
+// Throws unless the points span space: fewer than 4, or all on a plane,
+// have no Delaunay cells to reconstruct from.
+void check_spread(size_t n, const Triangulator *dt) {
+  if (n < 4 || !dt || dt->dimension() < 3) {
+    char buf[160];
+    int dim = dt ? dt->dimension() : -1;
+    if (n < 4)
+      std::snprintf(buf, sizeof buf,
+                    "need at least 4 points not all coplanar, got %zu", n);
+    else
+      std::snprintf(buf, sizeof buf, "all %zu points are %s", n,
+                    dim <= 0   ? "the same point"
+                    : dim == 1 ? "collinear"
+                               : "coplanar");
+    throw Error(SC_EDEGENERATE_INPUT, buf);
+  }
+}
+
+// Per-vertex normals (docs/algorithm.md section 13), by vertex number: the
+// pole direction, signed to agree with the area-weighted normal of the
+// output triangles around the vertex (zero for a vertex of no triangle).
+std::vector<double> vertex_normals(const std::vector<double> &lxyz, size_t m,
+                                   const std::vector<uint32_t> &tris,
+                                   const std::vector<double> &poles) {
+  std::vector<double> acc(3 * m, 0.0);
+  const size_t nt = tris.size() / 3;
+  for (size_t t = 0; t < nt; ++t) {
+    const uint32_t *v = &tris[3 * t];
+    const double *a = &lxyz[3 * size_t(v[0])], *b = &lxyz[3 * size_t(v[1])],
+                 *c = &lxyz[3 * size_t(v[2])];
+    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double nrm[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                     u[0] * w[1] - u[1] * w[0]};
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j)
+        acc[3 * size_t(v[k]) + j] += nrm[j];
+  }
+  for (size_t i = 0; i < m; ++i) {
+    double *a = &acc[3 * i];
+    const double *p = &poles[3 * i];
+    double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (!(la > 0))
+      continue; // not a vertex of the output: the normal stays zero
+    double d = a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
+    if (std::fabs(d) > 1e-3 * la) {
+      double s = d > 0 ? 1.0 : -1.0;
+      a[0] = s * p[0], a[1] = s * p[1], a[2] = s * p[2];
+    } else {
+      a[0] /= la, a[1] /= la, a[2] /= la;
+    }
+  }
+  return acc;
+}
+
+// The normals by vertex number, acc, by input index, duplicates given the
+// normal of the point they repeat.
+std::vector<double> normals_by_input(const std::vector<double> &acc,
+                                     const Filtered &f, size_t n) {
+  std::vector<double> normals(3 * n, 0.0);
+  for (size_t k = 0; k < f.to_input.size(); ++k)
+    std::memcpy(&normals[3 * size_t(f.to_input[k])], &acc[3 * k],
+                3 * sizeof(double));
+  for (auto &d : f.dups)
+    for (int j = 0; j < 3; ++j)
+      normals[3 * size_t(d.first) + j] = normals[3 * size_t(d.second) + j];
+  return normals;
+}
+
+// The mesh handed back to C, in malloc'ed arrays.
+sc_mesh_t *mesh_out(const Surface &surf, const std::vector<double> &normals,
+                    size_t n, const sc_diag_t &diag) {
+  sc_mesh_t *out = static_cast<sc_mesh_t *>(std::calloc(1, sizeof *out));
+  if (!out)
+    throw std::bad_alloc();
+  try {
+    out->triangles = copy_out(surf.tris.data(), surf.tris.size());
+    out->triangle_count = surf.tris.size() / 3;
+    out->normals = copy_out(normals.data(), normals.size());
+    out->point_count = n;
+    out->component_genus =
+        copy_out(surf.component_genus.data(), surf.component_genus.size());
+    out->component_count = surf.component_genus.size();
+    out->diag = diag;
+  } catch (...) {
+    sc_mesh_free(out);
+    throw;
+  }
+  return out;
+}
+
+} // namespace
+
+// The stages after insertion, in order: the triangulation's (duplicates,
+// poles, boundary detection, candidates: Triangulator::filter()), pruning,
+// extraction (the walk, small holes, description), then for scans dropping
+// bubbles, closing (watertight mode) and attaching samples; last the
+// normals and the mesh in input indices.
 sc_mesh_t *Recon::finish() {
   // However the reconstruction ends, the scratch it kept goes.
   struct ScratchRelease {
@@ -273,19 +373,7 @@ sc_mesh_t *Recon::finish() {
   std::memset(&diag, 0, sizeof diag);
   diag.points_in = n_;
 
-  if (n_ < 4 || !dt_ || dt_->dimension() < 3) {
-    char buf[160];
-    int dim = dt_ ? dt_->dimension() : -1;
-    if (n_ < 4)
-      std::snprintf(buf, sizeof buf,
-                    "need at least 4 points not all coplanar, got %zu", n_);
-    else
-      std::snprintf(buf, sizeof buf, "all %zu points are %s", n_,
-                    dim <= 0   ? "the same point"
-                    : dim == 1 ? "collinear"
-                               : "coplanar");
-    throw Error(SC_EDEGENERATE_INPUT, buf);
-  }
+  check_spread(n_, dt_.get());
 
   Filtered f;
   const bool watertight = params_.mode == SC_MODE_WATERTIGHT;
@@ -348,46 +436,10 @@ sc_mesh_t *Recon::finish() {
         attach_samples(lxyz.data(), m, surf, progress, diag);
   }
 
-  // Per-vertex normals (docs/algorithm.md section 13): the pole direction,
-  // signed to agree with the area-weighted normal of the output triangles
-  // around the vertex.
-  std::vector<double> acc(3 * m, 0.0);
-  const size_t nt = surf.tris.size() / 3;
-  for (size_t t = 0; t < nt; ++t) {
-    const uint32_t *v = &surf.tris[3 * t];
-    const double *a = &lxyz[3 * size_t(v[0])], *b = &lxyz[3 * size_t(v[1])],
-                 *c = &lxyz[3 * size_t(v[2])];
-    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    double nrm[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                     u[0] * w[1] - u[1] * w[0]};
-    for (int k = 0; k < 3; ++k)
-      for (int j = 0; j < 3; ++j)
-        acc[3 * size_t(v[k]) + j] += nrm[j];
-  }
-  for (size_t i = 0; i < m; ++i) {
-    double *a = &acc[3 * i];
-    const double *p = &f.poles[3 * i];
-    double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    if (!(la > 0))
-      continue; // not a vertex of the output: the normal stays zero
-    double d = a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
-    if (std::fabs(d) > 1e-3 * la) {
-      double s = d > 0 ? 1.0 : -1.0;
-      a[0] = s * p[0], a[1] = s * p[1], a[2] = s * p[2];
-    } else {
-      a[0] /= la, a[1] /= la, a[2] /= la;
-    }
-  }
+  std::vector<double> acc = vertex_normals(lxyz, m, surf.tris, f.poles);
   // Back to input indices.
   lxyz = std::vector<double>();
-  std::vector<double> normals(3 * n_, 0.0);
-  for (size_t k = 0; k < m; ++k)
-    std::memcpy(&normals[3 * size_t(f.to_input[k])], &acc[3 * k],
-                3 * sizeof(double));
-  for (auto &d : f.dups)
-    for (int j = 0; j < 3; ++j)
-      normals[3 * size_t(d.first) + j] = normals[3 * size_t(d.second) + j];
+  const std::vector<double> normals = normals_by_input(acc, f, n_);
   for (uint32_t &v : surf.tris)
     v = f.to_input[v];
   canonical_order(surf.tris, true);
@@ -399,23 +451,7 @@ sc_mesh_t *Recon::finish() {
   }
   progress.report(1.0);
 
-  sc_mesh_t *out = static_cast<sc_mesh_t *>(std::calloc(1, sizeof *out));
-  if (!out)
-    throw std::bad_alloc();
-  try {
-    out->triangles = copy_out(surf.tris.data(), surf.tris.size());
-    out->triangle_count = nt;
-    out->normals = copy_out(normals.data(), normals.size());
-    out->point_count = n_;
-    out->component_genus =
-        copy_out(surf.component_genus.data(), surf.component_genus.size());
-    out->component_count = surf.component_genus.size();
-    out->diag = diag;
-  } catch (...) {
-    sc_mesh_free(out);
-    throw;
-  }
-  return out;
+  return mesh_out(surf, normals, n_, diag);
 }
 
 } // namespace sc

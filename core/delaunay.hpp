@@ -1,0 +1,257 @@
+// What the stages that need the Delaunay triangulation share: the
+// triangulation's types, with what each vertex and cell carries, the
+// geometry on them, and the stages (one file each) that delaunay.cpp runs
+// in order. Only the files of those stages include this header, and it must
+// come before any CGAL header in them (see CGAL_ALLOCATOR below).
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+#ifndef SC_CORE_DELAUNAY_HPP
+#define SC_CORE_DELAUNAY_HPP
+
+#include "internal.hpp"
+#include "prefault.hpp"
+
+#ifdef CGAL_CONFIG_H
+#error "delaunay.hpp must come before any CGAL header"
+#endif
+// Blocks of cells and vertices come with their pages resident (see
+// prefault.hpp); CGAL's own default is std::allocator. The macro is CGAL's
+// hook for its containers' default allocator, and it must come before
+// CGAL's headers. It changes the instantiations of the files that include
+// this header, which are the only files of the core to include CGAL: they
+// all see the same allocator, so the triangulation types they share
+// (declared below, in a namespace of their own) are the same everywhere.
+// Other programs that link the core and include CGAL themselves (the modes
+// table) instantiate only CGAL's own vertex and cell types, never these.
+#define CGAL_ALLOCATOR(T) sc::PrefaultAllocator<T>
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Delaunay_triangulation_cell_base_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <type_traits>
+#include <vector>
+
+namespace sc {
+namespace dt {
+
+typedef CGAL::Exact_predicates_inexact_constructions_kernel K;
+typedef K::Point_3 Point;
+// What the filtering keeps on each vertex and cell, so that the pass over
+// the facets reads only the two cells of a facet and their vertices, never
+// arrays indexed by input order (which is random and would miss the cache at
+// every access on large inputs).
+struct VertexData {
+  uint32_t idx = 0; // index of the point in the input
+  float best = -1;  // squared distance to the pole so far; inf on the hull
+  double pole[3] = {0, 0, 0}; // pole direction, unit once computed
+  // Boundary detection (boundary, watertight and auto modes): squared
+  // distances to the farthest Voronoi vertex inside the cocone (r) and to
+  // the negative pole (h), and the kV* flags below.
+  float r2 = 0, h2 = 0;
+  float nn2 = std::numeric_limits<float>::infinity(); // nearest neighbour
+  uint8_t flags = 0;
+  VertexData() = default;
+  VertexData(uint32_t i) : idx(i) {}
+};
+enum : uint8_t {
+  kVRatio = 1,    // r <= rho h: the Voronoi cell is long and thin
+  kVDisagree = 2, // some cocone neighbour's pole is more than alpha away
+  kVInterior = 4, // an interior sample; the others are boundary samples
+};
+// Single precision is ample for where a Voronoi vertex lies relative to the
+// cocones and balls it is tested against, and keeps cells at 80 bytes.
+// Once the candidates are chosen the circumcentre is not needed any more,
+// and watertight mode reuses its bytes for the cell's label.
+struct CellLabel {
+  uint32_t local;      // scratch: the cell's place in a vertex's star
+  uint16_t vin, vout;  // surface triangles that put the cell inside, outside
+  uint8_t label;       // kUnlabelled, kInside, kOutside
+  uint8_t barrier;     // bit f: facet f is a surface triangle
+  uint8_t moved;       // relabelled once already: stays as it is now
+};
+enum : uint8_t { kUnlabelled = 0, kInside = 1, kOutside = 2 };
+// Boundary detection ignores, for the extent of a cell in the cocone, a
+// circumcentre farther than this from the cell's vertices, relative to the
+// cell's longest edge (squared).
+struct CellData {
+  union {
+    float cc[3];  // circumcentre (guarded), set by the poles stage
+    CellLabel w;  // watertight mode, after the candidates
+  };
+  CellData() : cc{0, 0, 0} {}
+  // An infinite cell has no circumcentre: the poles stage marks it with a
+  // NaN that no arithmetic on finite points gives (a NaN made by arithmetic
+  // has no payload), so that the candidates tell it by the bytes they read
+  // anyway.
+  static constexpr uint32_t kInfinite = 0x7fc5a5a5u;
+  void mark_infinite() { std::memcpy(&cc[0], &kInfinite, sizeof kInfinite); }
+  bool infinite() const {
+    uint32_t bits;
+    std::memcpy(&bits, &cc[0], sizeof bits);
+    return bits == kInfinite;
+  }
+};
+typedef CGAL::Triangulation_vertex_base_with_info_3<VertexData, K> Vb;
+typedef CGAL::Triangulation_cell_base_with_info_3<
+    CellData, K, CGAL::Delaunay_triangulation_cell_base_3<K>>
+    Cb;
+typedef CGAL::Triangulation_data_structure_3<Vb, Cb, CGAL::Sequential_tag>
+    TdsSeq;
+typedef CGAL::Delaunay_triangulation_3<K, TdsSeq> DtSeq;
+// Cells are most of the memory of a reconstruction: a byte more in
+// CellData makes them 88 bytes, and the peak 8% higher.
+static_assert(sizeof(TdsSeq::Cell) <= 80, "a cell grew beyond 80 bytes");
+// CGAL_ALLOCATOR above reached the containers of cells and vertices.
+static_assert(std::is_same<TdsSeq::Cell_range::allocator_type,
+                           PrefaultAllocator<TdsSeq::Cell>>::value &&
+                  std::is_same<TdsSeq::Vertex_range::allocator_type,
+                               PrefaultAllocator<TdsSeq::Vertex>>::value,
+              "the triangulation's blocks bypass PrefaultAllocator");
+#ifdef CGAL_LINKED_WITH_TBB
+typedef CGAL::Triangulation_data_structure_3<Vb, Cb, CGAL::Parallel_tag>
+    TdsPar;
+typedef CGAL::Delaunay_triangulation_3<
+    K, TdsPar, CGAL::Default,
+    CGAL::Spatial_lock_grid_3<CGAL::Tag_priority_blocking>>
+    DtPar;
+#endif
+
+struct V3 {
+  double x, y, z;
+};
+inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
+inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline V3 cross(V3 a, V3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z,
+          a.x * b.y - a.y * b.x};
+}
+inline double norm2(V3 a) { return dot(a, a); }
+inline V3 v3(const Point &p) { return {p.x(), p.y(), p.z()}; }
+inline bool finite(V3 a) {
+  return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
+}
+
+// Circumcentre of triangle abc; returns false when it is degenerate.
+inline bool tri_circumcentre(V3 a, V3 b, V3 c, V3 &out) {
+  V3 u = b - a, v = c - a, w = cross(u, v);
+  double w2 = norm2(w);
+  if (!(w2 > 0))
+    return false;
+  V3 num = norm2(u) * cross(v, w) + norm2(v) * cross(w, u);
+  out = a + (0.5 / w2) * num;
+  return finite(out);
+}
+
+// The thresholds of the candidate tests, computed once from the parameters.
+struct Criteria {
+  int mode;
+  double cos_theta1; // criterion 1: |cos(n_t, p_s)| >= this
+  double tan_phi;    // criterion 2: dual edge meets [-R tan phi, R tan phi]
+  double sin2_cocone; // cocone: cos^2(y - s, p_s) <= this
+
+  explicit Criteria(const sc_params_t &p)
+      : mode(p.mode == SC_MODE_SHORTCRUST ? SC_MODE_SHORTCRUST
+                                          : SC_MODE_COCONE) {
+    double r = p.r;
+    double a = std::asin(std::min(1.0, r / (1 - r)));
+    double b = std::asin(std::min(1.0, std::sqrt(3.0) * r / (1 - r)));
+    double theta1 = 2 * a + b;
+    double phi = std::asin(std::min(1.0, r / (2 * (1 - r)))) + b;
+    cos_theta1 = theta1 >= M_PI / 2 ? 0.0 : std::cos(theta1);
+    tan_phi = phi >= M_PI / 2 ? std::numeric_limits<double>::infinity()
+                              : std::tan(phi);
+    sin2_cocone = std::sin(p.cocone_theta) * std::sin(p.cocone_theta);
+  }
+};
+
+// Outward unit normal of the hull facet of infinite cell c (its infinite
+// vertex is vertex inf).
+template <class Ch> V3 hull_normal(Ch c, int inf, V3 *pts) {
+  // From the corner with the smallest vertex number, in the cell's cyclic
+  // order, so that the rounding does not depend on the order of insertion.
+  int first = 0;
+  for (int k = 1; k < 3; ++k)
+    if (c->vertex((inf + 1 + k) % 4)->info().idx <
+        c->vertex((inf + 1 + first) % 4)->info().idx)
+      first = k;
+  for (int k = 0; k < 3; ++k)
+    pts[k] = v3(c->vertex((inf + 1 + (first + k) % 3) % 4)->point());
+  V3 n = cross(pts[1] - pts[0], pts[2] - pts[0]);
+  Ch inner = c->neighbor(inf);
+  V3 o = v3(inner->vertex(inner->index(c))->point());
+  if (dot(n, o - pts[0]) > 0)
+    n = -1.0 * n;
+  double l = std::sqrt(norm2(n));
+  return l > 0 ? (1 / l) * n : V3{0, 0, 0};
+}
+
+// Calls visit(c) on every finite cell c, asking a few cells ahead for the
+// vertices and, with `neighbours`, for the data of the neighbouring cells
+// at higher addresses (what the candidates read): they are scattered over
+// memory, and waiting for each in turn was most of the time of these
+// passes.
+template <class DT, class Visit>
+void for_cells(DT &dt, bool neighbours, Visit &&visit) {
+  constexpr int kAhead = 4;
+  const auto end = dt.finite_cells_end();
+  auto ahead = dt.finite_cells_begin();
+  for (int i = 0; i < kAhead && ahead != end; ++i)
+    ++ahead;
+  for (auto c = dt.finite_cells_begin(); c != end; ++c) {
+    if (ahead != end) {
+      for (int j = 0; j < 4; ++j) {
+        const char *v = reinterpret_cast<const char *>(&*ahead->vertex(j));
+        __builtin_prefetch(v);
+        __builtin_prefetch(v + 64);
+        if (neighbours && &*ahead < &*ahead->neighbor(j))
+          __builtin_prefetch(&ahead->neighbor(j)->info());
+      }
+      ++ahead;
+    }
+    visit(c);
+  }
+}
+
+// The stages, in the order delaunay.cpp runs them; each is instantiated for
+// the sequential and the parallel triangulation in its own file.
+
+// Poles (poles.cpp): each vertex's pole direction, unit, and each finite
+// cell's circumcentre (CellData::cc); infinite receives the infinite cells,
+// marked as such, for the stages after.
+template <class DT>
+void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
+                   Progress &progress, sc_diag_t &diag);
+
+// Boundary detection (boundary.cpp), after the poles: marks the interior
+// samples (kVInterior) and fills boundary by vertex number (or leaves it
+// empty, every sample interior, when too few are).
+template <class DT>
+void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
+              const sc_params_t &params, Progress &progress,
+              std::vector<uint8_t> &boundary, sc_diag_t &diag);
+
+// The candidate triangles (candidates.cpp), by vertex number, from the one
+// pass over the Delaunay facets; frees infinite.
+template <class DT>
+void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
+                       const sc_params_t &params, Progress &progress,
+                       std::vector<uint32_t> &tris, sc_diag_t &diag);
+
+// Watertight mode's labelling of the cells (labels.cpp): see
+// Triangulator::close().
+template <class DT>
+bool label_and_close(DT &dt, std::vector<uint32_t> &tris, Progress &progress,
+                     sc_diag_t &diag);
+
+} // namespace dt
+} // namespace sc
+
+#endif

@@ -1,0 +1,149 @@
+// The poles: for each sample, the direction to the farthest vertex of its
+// Voronoi cell (on the hull, the average outward normal of the hull facets
+// around it), which the candidate tests and the normals take for the
+// surface normal's line. Each cell keeps its circumcentre for the stages
+// after.
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+
+#include "delaunay.hpp"
+
+#include <tuple>
+
+namespace sc {
+namespace dt {
+namespace {
+
+// Circumcentre of a tetrahedron. Nearly flat cells (cospherical points on
+// grid-like scans) give a centre that is huge or not finite; those fall back
+// to the circumcentre of their largest facet and set `guarded`.
+V3 cell_circumcentre(V3 a, V3 b, V3 c, V3 d, bool &guarded) {
+  V3 u = b - a, v = c - a, w = d - a;
+  V3 vw = cross(v, w);
+  double det = dot(u, vw);
+  double scale = std::sqrt(norm2(u) * norm2(v) * norm2(w));
+  guarded = false;
+  if (std::fabs(det) > 1e-10 * scale) {
+    V3 num = norm2(u) * vw + norm2(v) * cross(w, u) + norm2(w) * cross(u, v);
+    V3 cc = a + (0.5 / det) * num;
+    if (finite(cc))
+      return cc;
+  }
+  guarded = true;
+  const V3 p[4] = {a, b, c, d};
+  double best = -1;
+  V3 out = 0.25 * (a + b + c + d);
+  for (int i = 0; i < 4; ++i) {
+    V3 x = p[(i + 1) % 4], y = p[(i + 2) % 4], z = p[(i + 3) % 4];
+    double area2 = norm2(cross(y - x, z - x));
+    V3 cc;
+    if (area2 > best && tri_circumcentre(x, y, z, cc)) {
+      best = area2;
+      out = cc;
+    }
+  }
+  return out;
+}
+
+// The circumcentre of cell c (counting a guarded one in diag, if given).
+template <class DT>
+V3 centre(typename DT::Cell_handle c, sc_diag_t *diag) {
+  typedef typename DT::Vertex_handle Vh;
+  // Taken in the order of the vertex numbers: how a cell happens to order
+  // its vertices depends on the order of insertion, and on nearly flat
+  // cells the rounding of the centre is enough to change the surface.
+  Vh v[4] = {c->vertex(0), c->vertex(1), c->vertex(2), c->vertex(3)};
+  auto order = [&](int i, int j) {
+    if (v[j]->info().idx < v[i]->info().idx)
+      std::swap(v[i], v[j]);
+  };
+  order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
+  bool guarded;
+  V3 cc = cell_circumcentre(v3(v[0]->point()), v3(v[1]->point()),
+                            v3(v[2]->point()), v3(v[3]->point()), guarded);
+  if (guarded && diag)
+    ++diag->degenerate_cells;
+  return cc;
+}
+
+} // namespace
+
+template <class DT>
+void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
+                   Progress &progress, sc_diag_t &diag) {
+  typedef typename DT::Vertex_handle Vh;
+  typedef typename DT::Cell_handle Ch;
+  const float kHull = std::numeric_limits<float>::infinity();
+
+  // Samples on the convex hull: the pole is at infinity, in the direction
+  // of the average outward normal of the hull facets around them. The
+  // infinite cells are kept for boundary detection and the candidates.
+  infinite.clear();
+  dt.incident_cells(dt.infinite_vertex(), std::back_inserter(infinite));
+  for (Ch c : infinite) {
+    c->info().mark_infinite();
+    int inf = c->index(dt.infinite_vertex());
+    V3 pts[3];
+    V3 nrm = hull_normal(c, inf, pts);
+    // On a grid of 2^-30: sums of such numbers are exact, so they do not
+    // depend on the order of the cells.
+    for (double *x : {&nrm.x, &nrm.y, &nrm.z})
+      *x = std::ldexp(std::nearbyint(std::ldexp(*x, 30)), -30);
+    for (int k = 0; k < 3; ++k) {
+      VertexData &d = c->vertex((inf + 1 + k) % 4)->info();
+      d.pole[0] += nrm.x, d.pole[1] += nrm.y, d.pole[2] += nrm.z;
+      d.best = kHull;
+    }
+  }
+
+  // Interior samples: the farthest Voronoi vertex of their cell. Each
+  // cell keeps its circumcentre for the candidate pass.
+  size_t cells = dt.number_of_cells(), k = 0;
+  for_cells(dt, false, [&](auto c) {
+    progress.tick(k++, cells);
+    ++diag.delaunay_cells;
+    V3 cc = centre<DT>(c, &diag);
+    c->info().cc[0] = float(cc.x), c->info().cc[1] = float(cc.y),
+    c->info().cc[2] = float(cc.z);
+    for (int j = 0; j < 4; ++j) {
+      Vh v = c->vertex(j);
+      VertexData &d = v->info();
+      if (d.best == kHull)
+        continue;
+      V3 dv = cc - v3(v->point());
+      float d2 = float(norm2(dv));
+      // Of Voronoi vertices equally far in single precision, the one whose
+      // offset is the larger in lexicographic order, whichever cell comes
+      // first: the order of the cells in memory depends on the order of
+      // insertion.
+      if (d2 > d.best ||
+          (d2 == d.best &&
+           std::tie(dv.x, dv.y, dv.z) >
+               std::tie(d.pole[0], d.pole[1], d.pole[2]))) {
+        d.best = d2;
+        d.pole[0] = dv.x, d.pole[1] = dv.y, d.pole[2] = dv.z;
+      }
+    }
+  });
+  // Unit poles.
+  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end();
+       ++v) {
+    VertexData &d = v->info();
+    if (d.best == kHull)
+      ++diag.hull_vertices;
+    double l = std::sqrt(d.pole[0] * d.pole[0] + d.pole[1] * d.pole[1] +
+                         d.pole[2] * d.pole[2]);
+    if (l > 0)
+      d.pole[0] /= l, d.pole[1] /= l, d.pole[2] /= l;
+  }
+}
+
+template void compute_poles<DtSeq>(DtSeq &, std::vector<DtSeq::Cell_handle> &,
+                                   Progress &, sc_diag_t &);
+#ifdef CGAL_LINKED_WITH_TBB
+template void compute_poles<DtPar>(DtPar &, std::vector<DtPar::Cell_handle> &,
+                                   Progress &, sc_diag_t &);
+#endif
+
+} // namespace dt
+} // namespace sc
