@@ -80,6 +80,7 @@ void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
   // infinite cells are kept for boundary detection and the candidates.
   infinite.clear();
   dt.incident_cells(dt.infinite_vertex(), std::back_inserter(infinite));
+  diag.hull_facets = infinite.size();
   for (Ch c : infinite) {
     c->info().mark_infinite();
     int inf = c->index(dt.infinite_vertex());

@@ -351,7 +351,9 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
     "samples left out by extraction, then inserted into the nearest "         \
     "triangle")                                                                \
   X(handles_cut, uint64_t, , COUNT, "handles_cut",                             \
-    "watertight: handles that closed round a hole, cut before closing")
+    "watertight: handles that closed round a hole, cut before closing")        \
+  X(hull_facets, uint64_t, , COUNT, "hull_facets",                             \
+    "triangles of the convex hull")
 
 typedef struct sc_diag {
 #define SC_DIAG_FIELD_(field, type, dim, kind, wire, help) type field dim;
