@@ -569,6 +569,212 @@ static int parse_args(int argc, char **argv, config_t *cfg,
   return -1;
 }
 
+/* The points of the jobs: samples of the test surfaces, or the files'.
+ * 0, or 1 after a message. */
+static int load_inputs(config_t *cfg, uint64_t points, const char **files,
+                       size_t nfiles) {
+  if (points) {
+    cfg->ninputs = LOAD_SAMPLES;
+    cfg->inputs = calloc(cfg->ninputs, sizeof *cfg->inputs);
+    for (size_t i = 0; cfg->inputs && i < cfg->ninputs; i++) {
+      input_t *in = &cfg->inputs[i];
+      in->surface = surfaces[i % (sizeof surfaces / sizeof surfaces[0])];
+      in->name = scs_surface_name((scs_surface_t)in->surface);
+      in->n = points;
+      in->xyz = malloc((size_t)points * 3 * sizeof(double));
+      if (!in->xyz ||
+          scs_sample_surface((scs_surface_t)in->surface, SCS_DENSITY_UNIFORM,
+                             (size_t)points, 1000 + i, in->xyz) != SCS_OK) {
+        say("cannot make a sample of %llu points", (unsigned long long)points);
+        return 1;
+      }
+    }
+  } else {
+    cfg->ninputs = nfiles;
+    cfg->inputs = calloc(cfg->ninputs, sizeof *cfg->inputs);
+    for (size_t i = 0; cfg->inputs && i < nfiles; i++) {
+      input_t *in = &cfg->inputs[i];
+      scf_points_t pts;
+      char msg[1024];
+      if (scf_points_read(files[i], &pts, msg, sizeof msg) < 0) {
+        say("%s", msg);
+        return 1;
+      }
+      in->name = files[i];
+      in->surface = -1;
+      in->xyz = pts.xyz;
+      in->n = pts.count;
+    }
+  }
+  if (!cfg->inputs) {
+    say("out of memory");
+    return 1;
+  }
+  return 0;
+}
+
+/* Runs the clients, one thread each, until they are done; returns how
+ * many started. */
+static unsigned run_workers(config_t *cfg, worker_t *w) {
+  unsigned started = 0;
+  for (unsigned i = 0; i < cfg->clients; i++) {
+    w[i].cfg = cfg;
+    w[i].index = i;
+    if (cfg->jobs == UINT64_MAX)
+      w[i].share = UINT64_MAX;
+    else
+      w[i].share = cfg->jobs / cfg->clients + (i < cfg->jobs % cfg->clients);
+    if (pthread_create(&w[i].thread, NULL, run_worker, &w[i]) != 0) {
+      say("cannot start thread %u: %s", i, strerror(errno));
+      break;
+    }
+    started++;
+  }
+  for (unsigned i = 0; i < started; i++)
+    pthread_join(w[i].thread, NULL);
+  return started;
+}
+
+/* The threads' tallies, together, latencies sorted. */
+static void merge_tallies(const worker_t *w, unsigned started, tally_t *all) {
+  memset(all, 0, sizeof *all);
+  for (unsigned i = 0; i < started; i++) {
+    const tally_t *t = &w[i].t;
+    all->done += t->done;
+    all->points += t->points;
+    all->verified += t->verified;
+    all->verify_failures += t->verify_failures;
+    for (size_t k = 0; k < t->nlat; k++)
+      add_latency(all, t->latency_ms[k]);
+    for (size_t k = 0; k < t->ncodes; k++) {
+      size_t j = 0;
+      while (j < all->ncodes && strcmp(all->codes[j].name, t->codes[k].name))
+        j++;
+      if (j == all->ncodes && all->ncodes < LOAD_MAX_CODES)
+        snprintf(all->codes[all->ncodes++].name, sizeof all->codes[0].name,
+                 "%s", t->codes[k].name);
+      if (j < LOAD_MAX_CODES)
+        all->codes[j].count += t->codes[k].count;
+    }
+    all->failed += t->failed;
+    if (!all->first_error[0] && t->first_error[0])
+      snprintf(all->first_error, sizeof all->first_error, "%s",
+               t->first_error);
+    for (unsigned k = 0; k < t->nshown && all->nshown < LOAD_SHOW_FAILURES;
+         k++)
+      snprintf(all->first_failure[all->nshown++], sizeof all->first_failure[0],
+               "%s", t->first_failure[k]);
+  }
+  if (all->nlat)
+    qsort(all->latency_ms, all->nlat, sizeof(double), cmp_double);
+}
+
+/* What a run measured, for the report. */
+typedef struct summary {
+  const tally_t *all;
+  uint64_t points; /* per job, or 0 for files */
+  size_t nfiles;
+  const char *where;
+  double seconds, p50, p90, p99, pmax, jobs_per_s, points_per_s;
+  const sc_client_value_t *before, *after;
+  size_t nbefore, nafter;
+} summary_t;
+
+static void print_daemon_counters(const summary_t *s) {
+  static const char *const shown[] = {
+      "jobs_accepted_total",   "jobs_refused_total",       "jobs_done_total",
+      "jobs_failed_total",     "jobs_cancelled_total",     "points_in_total",
+      "triangles_out_total",   "bytes_in_total",           "bytes_out_total",
+      "protocol_errors_total", "slow_readers_closed_total"};
+  if (!s->before || !s->after) {
+    printf("daemon      counters unavailable (%s)\n",
+           s->before ? "after the run" : "before the run");
+    return;
+  }
+  printf("daemon      ");
+  const char *sep = "";
+  for (size_t k = 0; k < sizeof shown / sizeof shown[0]; k++) {
+    const sc_client_value_t *a =
+        sc_client_value_find(s->before, s->nbefore, shown[k]);
+    const sc_client_value_t *b =
+        sc_client_value_find(s->after, s->nafter, shown[k]);
+    if (!a || !b || a->kind != SC_CLIENT_U64 || b->kind != SC_CLIENT_U64)
+      continue;
+    printf("%s%s +%llu", sep, shown[k], (unsigned long long)(b->v.u - a->v.u));
+    sep = ", ";
+  }
+  printf("\n");
+}
+
+static void print_text(const config_t *cfg, const summary_t *s) {
+  const tally_t *all = s->all;
+  uint64_t ended = all->done + all->failed;
+  printf("shortcrust-load: %u client%s, %llu job%s", cfg->clients,
+         cfg->clients == 1 ? "" : "s", (unsigned long long)ended,
+         ended == 1 ? "" : "s");
+  if (s->points)
+    printf(" of %llu points", (unsigned long long)s->points);
+  else
+    printf(" from %zu file%s", s->nfiles, s->nfiles == 1 ? "" : "s");
+  printf(", %u in flight per client, on %s\n", cfg->in_flight, s->where);
+  printf("jobs        %llu done, %llu failed, in %.2f s\n",
+         (unsigned long long)all->done, (unsigned long long)all->failed,
+         s->seconds);
+  printf("throughput  %.2f jobs/s, %.0f points/s\n", s->jobs_per_s,
+         s->points_per_s);
+  printf("latency     p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms\n",
+         s->p50, s->p90, s->p99, s->pmax);
+  printf("errors      ");
+  if (all->ncodes == 0)
+    printf("none\n");
+  for (size_t k = 0; k < all->ncodes; k++)
+    printf("%s%s %llu%s", k ? ", " : "", all->codes[k].name,
+           (unsigned long long)all->codes[k].count,
+           k + 1 == all->ncodes ? "\n" : "");
+  if (all->first_error[0])
+    printf("            first: %s\n", all->first_error);
+  if (cfg->verify) {
+    printf("verify      %llu mesh%s checked, %llu failure%s\n",
+           (unsigned long long)all->verified, all->verified == 1 ? "" : "es",
+           (unsigned long long)all->verify_failures,
+           all->verify_failures == 1 ? "" : "s");
+    for (unsigned k = 0; k < all->nshown; k++)
+      printf("            %s\n", all->first_failure[k]);
+  }
+  print_daemon_counters(s);
+}
+
+static void print_json(const config_t *cfg, const summary_t *s) {
+  const tally_t *all = s->all;
+  printf("{\"clients\": %u, \"jobs_in_flight\": %u, ", cfg->clients,
+         cfg->in_flight);
+  if (s->points)
+    printf("\"points\": %llu, ", (unsigned long long)s->points);
+  else
+    printf("\"files\": %zu, ", s->nfiles);
+  printf("\"jobs\": %llu, \"jobs_done\": %llu, \"errors\": %llu, "
+         "\"errors_by_code\": {",
+         (unsigned long long)(all->done + all->failed),
+         (unsigned long long)all->done, (unsigned long long)all->failed);
+  for (size_t k = 0; k < all->ncodes; k++) {
+    printf("%s", k ? ", " : "");
+    scf_json_string(stdout, all->codes[k].name);
+    printf(": %llu", (unsigned long long)all->codes[k].count);
+  }
+  printf("}, \"verify\": %s, \"verified\": %llu, \"verify_failures\": %llu, "
+         "\"seconds\": %.6f, \"jobs_per_s\": %.6f, \"points_per_s\": %.3f, "
+         "\"latency_p50_ms\": %.3f, \"latency_p90_ms\": %.3f, "
+         "\"latency_p99_ms\": %.3f, \"latency_max_ms\": %.3f, "
+         "\"daemon_before\": ",
+         cfg->verify ? "true" : "false", (unsigned long long)all->verified,
+         (unsigned long long)all->verify_failures, s->seconds, s->jobs_per_s,
+         s->points_per_s, s->p50, s->p90, s->p99, s->pmax);
+  json_values(stdout, s->before, s->nbefore);
+  printf(", \"daemon_after\": ");
+  json_values(stdout, s->after, s->nafter);
+  printf("}\n");
+}
+
 int main(int argc, char **argv) {
   config_t cfg;
   memset(&cfg, 0, sizeof cfg);
@@ -591,44 +797,8 @@ int main(int argc, char **argv) {
 
   /* A daemon that goes away must show as an error, not kill the run. */
   signal(SIGPIPE, SIG_IGN);
-
-  if (points) {
-    cfg.ninputs = LOAD_SAMPLES;
-    cfg.inputs = calloc(cfg.ninputs, sizeof *cfg.inputs);
-    for (size_t i = 0; cfg.inputs && i < cfg.ninputs; i++) {
-      input_t *in = &cfg.inputs[i];
-      in->surface = surfaces[i % (sizeof surfaces / sizeof surfaces[0])];
-      in->name = scs_surface_name((scs_surface_t)in->surface);
-      in->n = points;
-      in->xyz = malloc((size_t)points * 3 * sizeof(double));
-      if (!in->xyz ||
-          scs_sample_surface((scs_surface_t)in->surface, SCS_DENSITY_UNIFORM,
-                             (size_t)points, 1000 + i, in->xyz) != SCS_OK) {
-        say("cannot make a sample of %llu points", (unsigned long long)points);
-        return 1;
-      }
-    }
-  } else {
-    cfg.ninputs = nfiles;
-    cfg.inputs = calloc(cfg.ninputs, sizeof *cfg.inputs);
-    for (size_t i = 0; cfg.inputs && i < nfiles; i++) {
-      input_t *in = &cfg.inputs[i];
-      scf_points_t pts;
-      char msg[1024];
-      if (scf_points_read(files[i], &pts, msg, sizeof msg) < 0) {
-        say("%s", msg);
-        return 1;
-      }
-      in->name = files[i];
-      in->surface = -1;
-      in->xyz = pts.xyz;
-      in->n = pts.count;
-    }
-  }
-  if (!cfg.inputs) {
-    say("out of memory");
+  if (load_inputs(&cfg, points, files, nfiles) != 0)
     return 1;
-  }
 
   char sock[256];
   const char *where = cfg.socket_path
@@ -644,146 +814,32 @@ int main(int argc, char **argv) {
   }
   double t_start = now_s();
   cfg.stop_at = cfg.duration > 0 ? t_start + cfg.duration : INFINITY;
-  unsigned started = 0;
-  for (unsigned i = 0; i < cfg.clients; i++) {
-    w[i].cfg = &cfg;
-    w[i].index = i;
-    if (cfg.jobs == UINT64_MAX)
-      w[i].share = UINT64_MAX;
-    else
-      w[i].share = cfg.jobs / cfg.clients + (i < cfg.jobs % cfg.clients);
-    if (pthread_create(&w[i].thread, NULL, run_worker, &w[i]) != 0) {
-      say("cannot start thread %u: %s", i, strerror(errno));
-      break;
-    }
-    started++;
-  }
-  for (unsigned i = 0; i < started; i++)
-    pthread_join(w[i].thread, NULL);
+  unsigned started = run_workers(&cfg, w);
   double seconds = now_s() - t_start;
   sc_client_value_t *after = daemon_stats(&cfg, &nafter);
 
-  /* The threads' tallies, together. */
   tally_t all;
-  memset(&all, 0, sizeof all);
-  for (unsigned i = 0; i < started; i++) {
-    tally_t *t = &w[i].t;
-    all.done += t->done;
-    all.points += t->points;
-    all.verified += t->verified;
-    all.verify_failures += t->verify_failures;
-    for (size_t k = 0; k < t->nlat; k++)
-      add_latency(&all, t->latency_ms[k]);
-    for (size_t k = 0; k < t->ncodes; k++) {
-      size_t j = 0;
-      while (j < all.ncodes && strcmp(all.codes[j].name, t->codes[k].name))
-        j++;
-      if (j == all.ncodes && all.ncodes < LOAD_MAX_CODES)
-        snprintf(all.codes[all.ncodes++].name, sizeof all.codes[0].name, "%s",
-                 t->codes[k].name);
-      if (j < LOAD_MAX_CODES)
-        all.codes[j].count += t->codes[k].count;
-    }
-    all.failed += t->failed;
-    if (!all.first_error[0] && t->first_error[0])
-      snprintf(all.first_error, sizeof all.first_error, "%s", t->first_error);
-    for (unsigned k = 0; k < t->nshown && all.nshown < LOAD_SHOW_FAILURES; k++)
-      snprintf(all.first_failure[all.nshown++], sizeof all.first_failure[0],
-               "%s", t->first_failure[k]);
-  }
-  if (all.nlat)
-    qsort(all.latency_ms, all.nlat, sizeof(double), cmp_double);
-  double p50 = quantile(all.latency_ms, all.nlat, 0.50);
-  double p90 = quantile(all.latency_ms, all.nlat, 0.90);
-  double p99 = quantile(all.latency_ms, all.nlat, 0.99);
-  double pmax = all.nlat ? all.latency_ms[all.nlat - 1] : 0;
-  double jobs_per_s = seconds > 0 ? (double)all.done / seconds : 0;
-  double points_per_s = seconds > 0 ? (double)all.points / seconds : 0;
-  uint64_t ended = all.done + all.failed;
-
-  printf("shortcrust-load: %u client%s, %llu job%s", cfg.clients,
-         cfg.clients == 1 ? "" : "s", (unsigned long long)ended,
-         ended == 1 ? "" : "s");
-  if (points)
-    printf(" of %llu points", (unsigned long long)points);
-  else
-    printf(" from %zu file%s", nfiles, nfiles == 1 ? "" : "s");
-  printf(", %u in flight per client, on %s\n", cfg.in_flight, where);
-  printf("jobs        %llu done, %llu failed, in %.2f s\n",
-         (unsigned long long)all.done, (unsigned long long)all.failed, seconds);
-  printf("throughput  %.2f jobs/s, %.0f points/s\n", jobs_per_s, points_per_s);
-  printf("latency     p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms\n",
-         p50, p90, p99, pmax);
-  printf("errors      ");
-  if (all.ncodes == 0)
-    printf("none\n");
-  for (size_t k = 0; k < all.ncodes; k++)
-    printf("%s%s %llu%s", k ? ", " : "", all.codes[k].name,
-           (unsigned long long)all.codes[k].count,
-           k + 1 == all.ncodes ? "\n" : "");
-  if (all.first_error[0])
-    printf("            first: %s\n", all.first_error);
-  if (cfg.verify) {
-    printf("verify      %llu mesh%s checked, %llu failure%s\n",
-           (unsigned long long)all.verified, all.verified == 1 ? "" : "es",
-           (unsigned long long)all.verify_failures,
-           all.verify_failures == 1 ? "" : "s");
-    for (unsigned k = 0; k < all.nshown; k++)
-      printf("            %s\n", all.first_failure[k]);
-  }
-  static const char *const shown[] = {
-      "jobs_accepted_total",   "jobs_refused_total",       "jobs_done_total",
-      "jobs_failed_total",     "jobs_cancelled_total",     "points_in_total",
-      "triangles_out_total",   "bytes_in_total",           "bytes_out_total",
-      "protocol_errors_total", "slow_readers_closed_total"};
-  if (before && after) {
-    printf("daemon      ");
-    const char *sep = "";
-    for (size_t k = 0; k < sizeof shown / sizeof shown[0]; k++) {
-      const sc_client_value_t *a =
-          sc_client_value_find(before, nbefore, shown[k]);
-      const sc_client_value_t *b =
-          sc_client_value_find(after, nafter, shown[k]);
-      if (!a || !b || a->kind != SC_CLIENT_U64 || b->kind != SC_CLIENT_U64)
-        continue;
-      printf("%s%s +%llu", sep, shown[k],
-             (unsigned long long)(b->v.u - a->v.u));
-      sep = ", ";
-    }
-    printf("\n");
-  } else {
-    printf("daemon      counters unavailable (%s)\n",
-           before ? "after the run" : "before the run");
-  }
-  if (cfg.json) {
-    printf("{\"clients\": %u, \"jobs_in_flight\": %u, ", cfg.clients,
-           cfg.in_flight);
-    if (points)
-      printf("\"points\": %llu, ", (unsigned long long)points);
-    else
-      printf("\"files\": %zu, ", nfiles);
-    printf("\"jobs\": %llu, \"jobs_done\": %llu, \"errors\": %llu, "
-           "\"errors_by_code\": {",
-           (unsigned long long)ended, (unsigned long long)all.done,
-           (unsigned long long)all.failed);
-    for (size_t k = 0; k < all.ncodes; k++) {
-      printf("%s", k ? ", " : "");
-      scf_json_string(stdout, all.codes[k].name);
-      printf(": %llu", (unsigned long long)all.codes[k].count);
-    }
-    printf("}, \"verify\": %s, \"verified\": %llu, \"verify_failures\": %llu, "
-           "\"seconds\": %.6f, \"jobs_per_s\": %.6f, \"points_per_s\": %.3f, "
-           "\"latency_p50_ms\": %.3f, \"latency_p90_ms\": %.3f, "
-           "\"latency_p99_ms\": %.3f, \"latency_max_ms\": %.3f, "
-           "\"daemon_before\": ",
-           cfg.verify ? "true" : "false", (unsigned long long)all.verified,
-           (unsigned long long)all.verify_failures, seconds, jobs_per_s,
-           points_per_s, p50, p90, p99, pmax);
-    json_values(stdout, before, nbefore);
-    printf(", \"daemon_after\": ");
-    json_values(stdout, after, nafter);
-    printf("}\n");
-  }
+  merge_tallies(w, started, &all);
+  summary_t sum = {
+      .all = &all,
+      .points = points,
+      .nfiles = nfiles,
+      .where = where,
+      .seconds = seconds,
+      .p50 = quantile(all.latency_ms, all.nlat, 0.50),
+      .p90 = quantile(all.latency_ms, all.nlat, 0.90),
+      .p99 = quantile(all.latency_ms, all.nlat, 0.99),
+      .pmax = all.nlat ? all.latency_ms[all.nlat - 1] : 0,
+      .jobs_per_s = seconds > 0 ? (double)all.done / seconds : 0,
+      .points_per_s = seconds > 0 ? (double)all.points / seconds : 0,
+      .before = before,
+      .after = after,
+      .nbefore = nbefore,
+      .nafter = nafter,
+  };
+  print_text(&cfg, &sum);
+  if (cfg.json)
+    print_json(&cfg, &sum);
 
   for (unsigned i = 0; i < cfg.clients; i++)
     free(w[i].t.latency_ms);
