@@ -9,11 +9,11 @@
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "internal.h"
+#include "shortcrust.h" /* SC_PI only: this module does not link the core */
 
 #include <math.h>
 #include <string.h>
 
-#define PI 3.14159265358979323846
 
 /* Ellipsoid semi-axes. */
 #define EA 1.0
@@ -65,13 +65,14 @@
 #define E_AREA 4.8344354495500
 
 static const scs_surface_info_t infos[SCS_SURF_COUNT] = {
-    [SCS_SURF_SPHERE] = {"sphere", 1, {0, 0}, 0, 4 * PI, {4 * PI / 3, 0},
+    [SCS_SURF_SPHERE] = {"sphere", 1, {0, 0}, 0, 4 * SC_PI, {4 * SC_PI / 3, 0},
                          {-1, -1, -1}, {1, 1, 1}, 1.0},
     [SCS_SURF_ELLIPSOID] = {"ellipsoid", 1, {0, 0}, 0, E_AREA,
-                            {4 * PI / 3 * EA * EB * EC, 0},
+                            {4 * SC_PI / 3 * EA * EB * EC, 0},
                             {-EA, -EB, -EC}, {EA, EB, EC}, EA / (EC * EC)},
-    [SCS_SURF_TORUS] = {"torus", 1, {1, 0}, 1, 4 * PI * PI * TOR_R * TOR_RR,
-                        {2 * PI * PI * TOR_R * TOR_RR * TOR_RR, 0},
+    [SCS_SURF_TORUS] = {"torus", 1, {1, 0}, 1,
+                        4 * SC_PI * SC_PI * TOR_R * TOR_RR,
+                        {2 * SC_PI * SC_PI * TOR_R * TOR_RR * TOR_RR, 0},
                         {-(TOR_R + TOR_RR), -(TOR_R + TOR_RR), -TOR_RR},
                         {TOR_R + TOR_RR, TOR_R + TOR_RR, TOR_RR},
                         1.0 / TOR_RR},
@@ -79,13 +80,13 @@ static const scs_surface_info_t infos[SCS_SURF_COUNT] = {
                          {-G2_SCALE * G2_X, -G2_SCALE * G2_Y, -G2_SCALE * G2_Z},
                          {G2_SCALE * G2_X, G2_SCALE * G2_Y, G2_SCALE * G2_Z},
                          G2_KMAX},
-    [SCS_SURF_TWO_SPHERES] = {"two-spheres", 2, {0, 0}, 0, 8 * PI,
-                              {4 * PI / 3, 4 * PI / 3},
+    [SCS_SURF_TWO_SPHERES] = {"two-spheres", 2, {0, 0}, 0, 8 * SC_PI,
+                              {4 * SC_PI / 3, 4 * SC_PI / 3},
                               {-TWO_X - 1, -1, -1}, {TWO_X + 1, 1, 1}, 1.0},
     [SCS_SURF_NESTED_SPHERES] = {"nested-spheres", 2, {0, 0}, 0,
-                                 4 * PI * (1 + NEST_IN * NEST_IN),
-                                 {4 * PI / 3,
-                                  4 * PI / 3 * NEST_IN * NEST_IN * NEST_IN},
+                                 4 * SC_PI * (1 + NEST_IN * NEST_IN),
+                                 {4 * SC_PI / 3,
+                                  4 * SC_PI / 3 * NEST_IN * NEST_IN * NEST_IN},
                                 {-1, -1, -1}, {1, 1, 1}, 1.0 / NEST_IN},
 };
 

@@ -25,7 +25,6 @@
 #include "shortcrust.h"
 #include "synth.h"
 
-#define PI 3.14159265358979323846
 
 static const double levels[] = {0, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5, 0.75, 1.0};
 #define LEVEL_COUNT (sizeof levels / sizeof levels[0])
@@ -47,7 +46,7 @@ static double gauss(scs_rng_t *rng) {
   double u = scs_rng_uniform(rng), v = scs_rng_uniform(rng);
   if (u < 1e-300)
     u = 1e-300;
-  return sqrt(-2 * log(u)) * cos(2 * PI * v);
+  return sqrt(-2 * log(u)) * cos(2 * SC_PI * v);
 }
 
 static void usage(FILE *f, const char *argv0) {

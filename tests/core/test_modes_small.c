@@ -108,7 +108,7 @@ int main(void) {
   sc_params_t p;
   sc_params_init(&p);
   EXPECT_LT(fabs(p.boundary_rho - 1.3), 1e-12);
-  EXPECT_LT(fabs(p.boundary_alpha - 3.14159265358979323846 / 9), 1e-12);
+  EXPECT_LT(fabs(p.boundary_alpha - SC_PI / 9), 1e-12);
   double tet[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
   sc_mesh_t *m = NULL;
   char msg[256] = "";

@@ -30,7 +30,6 @@
 #include "synth.h"
 #include "testsupport.h"
 
-#define PI 3.14159265358979323846
 
 enum {
   HEMISPHERE,
@@ -58,22 +57,24 @@ static const int closed_genus[OPEN_COUNT] = {0, 0, 0, 0, 1};
 #define HOLE_R 0.6
 static double HOLE_C[3] = {0, 0, 0};
 
-static double wavy(double x, double y) { return 0.15 * sin(3 * x) * cos(2 * y); }
+static double wavy(double x, double y) {
+  return 0.15 * sin(3 * x) * cos(2 * y);
+}
 
 static double open_area(int s) {
   switch (s) {
   case HEMISPHERE:
-    return 2 * PI;
+    return 2 * SC_PI;
   case WAVY_DISC:
-    return PI * 1.06; /* the waves add a few per cent; only the spacing
+    return SC_PI * 1.06; /* the waves add a few per cent; only the spacing
                          depends on it */
   case OPEN_CYLINDER:
-    return 2 * PI * CYL_R * 2 * CYL_H;
+    return 2 * SC_PI * CYL_R * 2 * CYL_H;
   case HOLED_TORUS:
     /* less the hole, about a disc of its radius */
-    return 4 * PI * PI * TOR_R * TOR_r - PI * HOLE_R * HOLE_R;
+    return 4 * SC_PI * SC_PI * TOR_R * TOR_r - SC_PI * HOLE_R * HOLE_R;
   default:
-    return 2 * PI * (1 + CUT_Z);
+    return 2 * SC_PI * (1 + CUT_Z);
   }
 }
 
@@ -91,7 +92,7 @@ static void open_point(int s, scs_rng_t *rng, double p[3]) {
     /* The tube angle by rejection against the area element, then outside
      * the hole. */
     for (;;) {
-      double t = 2 * PI * u, f = 2 * PI * v;
+      double t = 2 * SC_PI * u, f = 2 * SC_PI * v;
       double w = TOR_R + TOR_r * cos(f);
       p[0] = w * cos(t), p[1] = w * sin(t), p[2] = TOR_r * sin(f);
       if (scs_rng_uniform(rng) * (TOR_R + TOR_r) <= w &&
@@ -103,17 +104,17 @@ static void open_point(int s, scs_rng_t *rng, double p[3]) {
   case CUT_SPHERE: {
     /* Archimedes: z uniform gives area-uniform points on the sphere. */
     double z = s == HEMISPHERE ? u : -1 + u * (1 + CUT_Z);
-    double r = sqrt(1 - z * z), t = 2 * PI * v;
+    double r = sqrt(1 - z * z), t = 2 * SC_PI * v;
     p[0] = r * cos(t), p[1] = r * sin(t), p[2] = z;
     break;
   }
   case WAVY_DISC: {
-    double r = sqrt(u), t = 2 * PI * v;
+    double r = sqrt(u), t = 2 * SC_PI * v;
     p[0] = r * cos(t), p[1] = r * sin(t), p[2] = wavy(p[0], p[1]);
     break;
   }
   default: {
-    double t = 2 * PI * u;
+    double t = 2 * SC_PI * u;
     p[0] = CYL_R * cos(t), p[1] = CYL_R * sin(t), p[2] = CYL_H * (2 * v - 1);
     break;
   }
