@@ -15,31 +15,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mdtable.h"
 #include "sct_assert.h"
 #include "scproto.h"
-
-/* Splits a markdown table row into at most max trimmed cells; returns the
- * number of cells, or 0 for a line that is not a row. */
-static int row_cells(char *line, char **cells, int max) {
-  if (line[0] != '|')
-    return 0;
-  int n = 0;
-  char *p = line + 1;
-  while (n < max) {
-    char *bar = strchr(p, '|');
-    if (!bar)
-      break;
-    *bar = '\0';
-    while (isspace((unsigned char)*p) || *p == '`')
-      p++;
-    char *end = bar;
-    while (end > p && (isspace((unsigned char)end[-1]) || end[-1] == '`'))
-      *--end = '\0';
-    cells[n++] = p;
-    p = bar + 1;
-  }
-  return n;
-}
 
 typedef struct section_rows {
   int types, errors, modes, stages, formats;
