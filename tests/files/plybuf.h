@@ -8,7 +8,7 @@
 #ifndef SC_TESTS_PLYBUF_H
 #define SC_TESTS_PLYBUF_H
 
-#include "check.h"
+#include "tmpdir.h"
 
 #include <stdarg.h>
 #include <stdint.h>
@@ -28,7 +28,7 @@ static inline void buf_put(buf_t *b, const void *data, size_t len) {
       cap *= 2;
     unsigned char *p = realloc(b->p, cap);
     if (p == NULL)
-      CHECK_FAIL_("out of memory building a test file");
+      ASSERT_FAIL("out of memory building a test file");
     b->p = p;
     b->cap = cap;
   }
@@ -45,7 +45,7 @@ buf_printf(buf_t *b, const char *fmt, ...) {
   int n = vsnprintf(tmp, sizeof tmp, fmt, ap);
   va_end(ap);
   if (n < 0 || (size_t)n >= sizeof tmp)
-    CHECK_FAIL_("buf_printf: line too long");
+    ASSERT_FAIL("buf_printf: line too long");
   buf_put(b, tmp, (size_t)n);
 }
 

@@ -8,7 +8,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "check.h"
+#include "tmpdir.h"
 #include "shortcrust_files.h"
 
 #include <fcntl.h>
@@ -34,7 +34,7 @@ static void make_mesh(void) {
 static mode_t mode_of(const char *path) {
   struct stat st;
   if (stat(path, &st) != 0)
-    CHECK_FAIL_("cannot stat %s", path);
+    ASSERT_FAIL("cannot stat %s", path);
   return st.st_mode & 07777;
 }
 
@@ -44,16 +44,16 @@ static int temporaries(void) { return count_entries(tmp_path(""), ".tmp."); }
  * only, so it can be lifted again); writes past it fail with EFBIG. */
 static void limit_file_size(rlim_t limit) {
   struct rlimit rl;
-  CHECK(getrlimit(RLIMIT_FSIZE, &rl) == 0);
+  ASSERT(getrlimit(RLIMIT_FSIZE, &rl) == 0);
   rl.rlim_cur = limit;
-  CHECK(setrlimit(RLIMIT_FSIZE, &rl) == 0);
+  ASSERT(setrlimit(RLIMIT_FSIZE, &rl) == 0);
 }
 
 static void unlimit_file_size(void) {
   struct rlimit rl;
-  CHECK(getrlimit(RLIMIT_FSIZE, &rl) == 0);
+  ASSERT(getrlimit(RLIMIT_FSIZE, &rl) == 0);
   rl.rlim_cur = rl.rlim_max;
-  CHECK(setrlimit(RLIMIT_FSIZE, &rl) == 0);
+  ASSERT(setrlimit(RLIMIT_FSIZE, &rl) == 0);
 }
 
 /* A new file gets 0666 less the umask; a replaced one keeps its mode. */
@@ -61,26 +61,26 @@ static void test_modes(void) {
   char msg[256];
   mode_t old = umask(027);
   const char *path = tmp_path("new.ply");
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL, msg,
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL, msg,
                              sizeof msg),
                0);
-  CHECK_INT_EQ(mode_of(path), 0640);
+  ASSERT_EQ(mode_of(path), 0640);
   umask(022);
-  CHECK_INT_EQ(
+  ASSERT_EQ(
       scf_write_atomic(tmp_path("new.txt"), "x", 1, msg, sizeof msg), 0);
-  CHECK_INT_EQ(mode_of(tmp_path("new.txt")), 0644);
+  ASSERT_EQ(mode_of(tmp_path("new.txt")), 0644);
 
   /* Replacing keeps an unusual mode, whatever the umask says. */
-  CHECK(chmod(path, 0604) == 0);
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_OFF, xyz, 3, tri, 1, NULL, msg,
+  ASSERT(chmod(path, 0604) == 0);
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_OFF, xyz, 3, tri, 1, NULL, msg,
                              sizeof msg),
                0);
-  CHECK_INT_EQ(mode_of(path), 0604);
+  ASSERT_EQ(mode_of(path), 0604);
   char *s = read_all(path, NULL);
-  CHECK(strncmp(s, "OFF\n3 1 0\n", 10) == 0);
+  ASSERT(strncmp(s, "OFF\n3 1 0\n", 10) == 0);
   free(s);
   umask(old);
-  CHECK_INT_EQ(temporaries(), 0);
+  ASSERT_EQ(temporaries(), 0);
 }
 
 /*
@@ -91,46 +91,46 @@ static void test_modes(void) {
 static void test_replace(void) {
   char msg[256];
   const char *path = tmp_path("replace.txt");
-  CHECK_INT_EQ(
+  ASSERT_EQ(
       scf_write_atomic(path, "first version\n", 14, msg, sizeof msg), 0);
   int fd = open(path, O_RDONLY);
-  CHECK(fd >= 0);
+  ASSERT(fd >= 0);
   struct stat before, after;
-  CHECK(fstat(fd, &before) == 0);
-  CHECK_INT_EQ(scf_write_atomic(path, "second\n", 7, msg, sizeof msg), 0);
-  CHECK(stat(path, &after) == 0);
-  CHECK(before.st_ino != after.st_ino);
+  ASSERT(fstat(fd, &before) == 0);
+  ASSERT_EQ(scf_write_atomic(path, "second\n", 7, msg, sizeof msg), 0);
+  ASSERT(stat(path, &after) == 0);
+  ASSERT(before.st_ino != after.st_ino);
   char buf[32] = {0};
-  CHECK_INT_EQ(read(fd, buf, sizeof buf - 1), 14);
-  CHECK_STR_EQ(buf, "first version\n");
+  ASSERT_EQ(read(fd, buf, sizeof buf - 1), 14);
+  ASSERT_STR_EQ(buf, "first version\n");
   close(fd);
   char *s = read_all(path, NULL);
-  CHECK_STR_EQ(s, "second\n");
+  ASSERT_STR_EQ(s, "second\n");
   free(s);
 
   /* Empty data gives an empty file; data NULL with a length is refused. */
-  CHECK_INT_EQ(scf_write_atomic(path, NULL, 0, msg, sizeof msg), 0);
-  CHECK_U64_EQ(after.st_size, 7);
-  CHECK(stat(path, &after) == 0);
-  CHECK_U64_EQ(after.st_size, 0);
-  CHECK_INT_EQ(scf_write_atomic(path, NULL, 1, msg, sizeof msg),
+  ASSERT_EQ(scf_write_atomic(path, NULL, 0, msg, sizeof msg), 0);
+  ASSERT_EQ(after.st_size, 7);
+  ASSERT(stat(path, &after) == 0);
+  ASSERT_EQ(after.st_size, 0);
+  ASSERT_EQ(scf_write_atomic(path, NULL, 1, msg, sizeof msg),
                SCF_EINVAL);
-  CHECK_INT_EQ(scf_write_atomic(NULL, "x", 1, msg, sizeof msg),
+  ASSERT_EQ(scf_write_atomic(NULL, "x", 1, msg, sizeof msg),
                SCF_EINVAL);
-  CHECK_INT_EQ(temporaries(), 0);
+  ASSERT_EQ(temporaries(), 0);
 
   /* A name near the file system's limit still gets a temporary file. */
   char name[256];
   memset(name, 'n', 250);
   memcpy(name + 250, ".obj", 5);
   path = tmp_path(name);
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, 3, tri, 1, NULL, msg,
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, 3, tri, 1, NULL, msg,
                              sizeof msg),
                0);
   s = read_all(path, NULL);
-  CHECK(strncmp(s, "# written by shortcrust\nv 0 ", 28) == 0);
+  ASSERT(strncmp(s, "# written by shortcrust\nv 0 ", 28) == 0);
   free(s);
-  CHECK_INT_EQ(temporaries(), 0);
+  ASSERT_EQ(temporaries(), 0);
 }
 
 /*
@@ -147,29 +147,29 @@ static void test_failed_write(void) {
     snprintf(name, sizeof name, "fail%zu.mesh", f);
     const char *path = tmp_path(name);
     write_text(path, old_text);
-    CHECK(chmod(path, 0640) == 0);
+    ASSERT(chmod(path, 0640) == 0);
     struct stat before, after;
-    CHECK(stat(path, &before) == 0);
+    ASSERT(stat(path, &before) == 0);
     limit_file_size(4096);
     int rc =
         scf_mesh_write(path, formats[f], xyz, N, tri, NT, NULL, msg, sizeof msg);
     unlimit_file_size();
-    CHECK_INT_EQ(rc, SCF_EIO);
-    CHECK_CONTAINS(msg, path);
-    CHECK_CONTAINS(msg, "failed");
+    ASSERT_EQ(rc, SCF_EIO);
+    ASSERT_STR_CONTAINS(msg, path);
+    ASSERT_STR_CONTAINS(msg, "failed");
     char *s = read_all(path, NULL);
-    CHECK_STR_EQ(s, old_text);
+    ASSERT_STR_EQ(s, old_text);
     free(s);
-    CHECK(stat(path, &after) == 0);
-    CHECK(before.st_ino == after.st_ino);
-    CHECK_INT_EQ(mode_of(path), 0640);
-    CHECK_INT_EQ(temporaries(), 0);
+    ASSERT(stat(path, &after) == 0);
+    ASSERT(before.st_ino == after.st_ino);
+    ASSERT_EQ(mode_of(path), 0640);
+    ASSERT_EQ(temporaries(), 0);
   }
 
   /* The same for plain data, and for a target that did not exist. */
   size_t len = 100000;
   char *data = malloc(len);
-  CHECK(data != NULL);
+  ASSERT(data != NULL);
   memset(data, 'd', len);
   const char *path = tmp_path("fail.txt");
   write_text(path, old_text);
@@ -180,13 +180,13 @@ static void test_failed_write(void) {
       scf_write_atomic(tmp_path("never.txt"), data, len, msg, sizeof msg);
   unlimit_file_size();
   free(data);
-  CHECK_INT_EQ(rc, SCF_EIO);
-  CHECK_INT_EQ(rc_new, SCF_EIO);
+  ASSERT_EQ(rc, SCF_EIO);
+  ASSERT_EQ(rc_new, SCF_EIO);
   char *s = read_all(path, NULL);
-  CHECK_STR_EQ(s, old_text);
+  ASSERT_STR_EQ(s, old_text);
   free(s);
-  CHECK_INT_EQ(count_entries(tmp_path(""), "never"), 0);
-  CHECK_INT_EQ(temporaries(), 0);
+  ASSERT_EQ(count_entries(tmp_path(""), "never"), 0);
+  ASSERT_EQ(temporaries(), 0);
   signal(SIGXFSZ, SIG_DFL);
 }
 
@@ -195,27 +195,27 @@ static void test_failed_rename(void) {
   char msg[256];
   /* A directory in the way: everything is written, the rename fails. */
   const char *dir = tmp_path("taken.ply");
-  CHECK(mkdir(dir, 0700) == 0);
-  CHECK(mkdir(tmp_path("taken.ply/inside"), 0700) == 0);
-  CHECK_INT_EQ(scf_mesh_write(dir, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL, msg,
+  ASSERT(mkdir(dir, 0700) == 0);
+  ASSERT(mkdir(tmp_path("taken.ply/inside"), 0700) == 0);
+  ASSERT_EQ(scf_mesh_write(dir, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL, msg,
                              sizeof msg),
                SCF_EIO);
-  CHECK_CONTAINS(msg, dir);
-  CHECK_CONTAINS(msg, "rename");
+  ASSERT_STR_CONTAINS(msg, dir);
+  ASSERT_STR_CONTAINS(msg, "rename");
   struct stat st;
-  CHECK(stat(tmp_path("taken.ply/inside"), &st) == 0 && S_ISDIR(st.st_mode));
-  CHECK_INT_EQ(temporaries(), 0);
+  ASSERT(stat(tmp_path("taken.ply/inside"), &st) == 0 && S_ISDIR(st.st_mode));
+  ASSERT_EQ(temporaries(), 0);
 
   /* No directory to put it in. */
   const char *path = tmp_path("nowhere/out.ply");
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, 3, tri, 1, NULL, msg,
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, 3, tri, 1, NULL, msg,
                              sizeof msg),
                SCF_EIO);
-  CHECK_CONTAINS(msg, "cannot create a temporary file");
-  CHECK(stat(tmp_path("nowhere"), &st) != 0);
-  CHECK_INT_EQ(scf_write_atomic(path, "x", 1, msg, sizeof msg),
+  ASSERT_STR_CONTAINS(msg, "cannot create a temporary file");
+  ASSERT(stat(tmp_path("nowhere"), &st) != 0);
+  ASSERT_EQ(scf_write_atomic(path, "x", 1, msg, sizeof msg),
                SCF_EIO);
-  CHECK_INT_EQ(temporaries(), 0);
+  ASSERT_EQ(temporaries(), 0);
 }
 
 int main(void) {
@@ -225,5 +225,5 @@ int main(void) {
   test_replace();
   test_failed_write();
   test_failed_rename();
-  return 0;
+  return sct_finish("files_atomic");
 }

@@ -8,7 +8,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "check.h"
+#include "tmpdir.h"
 #include "shortcrust_files.h"
 
 #include <math.h>
@@ -46,9 +46,9 @@ static int cmp_point(const void *a, const void *b) {
 }
 
 static void check_same(const scf_points_t *a, const scf_points_t *b) {
-  CHECK_U64_EQ(a->count, b->count);
+  ASSERT_EQ(a->count, b->count);
   for (size_t i = 0; i < 3 * a->count; i++)
-    CHECK_DBL_SAME(a->xyz[i], b->xyz[i]);
+    ASSERT_DBL_SAME(a->xyz[i], b->xyz[i]);
 }
 
 static void check_file(const char *dir, const expected_t *e) {
@@ -57,8 +57,8 @@ static void check_file(const char *dir, const expected_t *e) {
   scf_points_t p;
   int rc = scf_points_read(path, &p, msg, sizeof msg);
   if (rc != 0)
-    CHECK_FAIL_("%s", msg);
-  CHECK_U64_EQ(p.count, e->count);
+    ASSERT_FAIL("%s", msg);
+  ASSERT_EQ(p.count, e->count);
 
   double lo[3], hi[3];
   for (int c = 0; c < 3; c++)
@@ -66,26 +66,26 @@ static void check_file(const char *dir, const expected_t *e) {
   for (size_t i = 0; i < p.count; i++)
     for (int c = 0; c < 3; c++) {
       double v = p.xyz[3 * i + c];
-      CHECK(isfinite(v));
-      CHECK_DBL_SAME(v, (double)(float)v);
+      ASSERT(isfinite(v));
+      ASSERT_DBL_SAME(v, (double)(float)v);
       lo[c] = v < lo[c] ? v : lo[c];
       hi[c] = v > hi[c] ? v : hi[c];
     }
   for (int c = 0; c < 3; c++) {
-    CHECK_DBL_SAME(lo[c], e->lo[c]);
-    CHECK_DBL_SAME(hi[c], e->hi[c]);
-    CHECK_DBL_SAME(p.xyz[c], e->first[c]);
-    CHECK_DBL_SAME(p.xyz[3 * (p.count - 1) + c], e->last[c]);
+    ASSERT_DBL_SAME(lo[c], e->lo[c]);
+    ASSERT_DBL_SAME(hi[c], e->hi[c]);
+    ASSERT_DBL_SAME(p.xyz[c], e->first[c]);
+    ASSERT_DBL_SAME(p.xyz[3 * (p.count - 1) + c], e->last[c]);
   }
 
   /* No point twice: reconstruction input from a mesh's vertex set. */
   double *sorted = malloc(3 * p.count * sizeof *sorted);
-  CHECK(sorted != NULL);
+  ASSERT(sorted != NULL);
   memcpy(sorted, p.xyz, 3 * p.count * sizeof *sorted);
   qsort(sorted, p.count, 3 * sizeof *sorted, cmp_point);
   for (size_t i = 1; i < p.count; i++)
     if (cmp_point(sorted + 3 * (i - 1), sorted + 3 * i) == 0)
-      CHECK_FAIL_("%s: point %.9g %.9g %.9g appears twice", e->name,
+      ASSERT_FAIL("%s: point %.9g %.9g %.9g appears twice", e->name,
                   sorted[3 * i], sorted[3 * i + 1], sorted[3 * i + 2]);
   free(sorted);
 
@@ -93,9 +93,9 @@ static void check_file(const char *dir, const expected_t *e) {
   scf_points_t m;
   uint32_t *tri;
   size_t nt;
-  CHECK_INT_EQ(scf_mesh_read(path, &m, &tri, &nt, msg, sizeof msg), 0);
+  ASSERT_EQ(scf_mesh_read(path, &m, &tri, &nt, msg, sizeof msg), 0);
   check_same(&p, &m);
-  CHECK_U64_EQ(nt, 0);
+  ASSERT_EQ(nt, 0);
   scf_points_free(&m);
 
   /* Written and read back, in binary and in ascii. */
@@ -103,10 +103,10 @@ static void check_file(const char *dir, const expected_t *e) {
                                           SCF_MESH_FMT_PLY_ASCII};
   for (int f = 0; f < 2; f++) {
     const char *copy = tmp_path("copy.ply");
-    CHECK_INT_EQ(scf_mesh_write(copy, fmts[f], p.xyz, p.count, NULL, 0, NULL,
+    ASSERT_EQ(scf_mesh_write(copy, fmts[f], p.xyz, p.count, NULL, 0, NULL,
                                msg, sizeof msg),
                  0);
-    CHECK_INT_EQ(scf_points_read(copy, &m, msg, sizeof msg), 0);
+    ASSERT_EQ(scf_points_read(copy, &m, msg, sizeof msg), 0);
     check_same(&p, &m);
     scf_points_free(&m);
   }
@@ -123,5 +123,5 @@ int main(int argc, char **argv) {
   tmp_init();
   for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
     check_file(argv[1], &files[i]);
-  return 0;
+  return sct_finish("files_data");
 }

@@ -7,7 +7,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "check.h"
+#include "tmpdir.h"
 #include "shortcrust_files.h"
 #include "plybuf.h"
 
@@ -23,22 +23,22 @@ static void expect_fail(const char *path, int mesh, int rc, const char *frag1,
   int got = mesh ? scf_mesh_read(path, &p, &tri, &nt, msg, sizeof msg)
                  : scf_points_read(path, &p, msg, sizeof msg);
   if (got != rc)
-    CHECK_FAIL_("reading %s: %s (%s), expected %s", path, scf_err_name(got),
+    ASSERT_FAIL("reading %s: %s (%s), expected %s", path, scf_err_name(got),
                 got ? msg : "", scf_err_name(rc));
-  CHECK(p.xyz == NULL);
-  CHECK_U64_EQ(p.count, 0);
+  ASSERT(p.xyz == NULL);
+  ASSERT_EQ(p.count, 0);
   if (mesh) {
-    CHECK(tri == NULL);
-    CHECK_U64_EQ(nt, 0);
+    ASSERT(tri == NULL);
+    ASSERT_EQ(nt, 0);
   }
-  CHECK(memchr(msg, '\0', sizeof msg) != NULL);
-  CHECK(strchr(msg, '\n') == NULL);
+  ASSERT(memchr(msg, '\0', sizeof msg) != NULL);
+  ASSERT(strchr(msg, '\n') == NULL);
   if (strncmp(msg, path, strlen(path)) != 0 || msg[strlen(path)] != ':')
-    CHECK_FAIL_("\"%s\" does not start with \"%s:\"", msg, path);
+    ASSERT_FAIL("\"%s\" does not start with \"%s:\"", msg, path);
   if (frag1 != NULL)
-    CHECK_CONTAINS(msg, frag1);
+    ASSERT_STR_CONTAINS(msg, frag1);
   if (frag2 != NULL)
-    CHECK_CONTAINS(msg, frag2);
+    ASSERT_STR_CONTAINS(msg, frag2);
 }
 
 typedef struct bad_case {
@@ -131,9 +131,9 @@ static void test_bad_headers(void) {
   run_cases(bad_headers, sizeof bad_headers / sizeof bad_headers[0]);
   scf_points_t p;
   char msg[256];
-  CHECK_INT_EQ(scf_points_read(tmp_path("noindices.ply"), &p, msg, sizeof msg),
+  ASSERT_EQ(scf_points_read(tmp_path("noindices.ply"), &p, msg, sizeof msg),
                0);
-  CHECK_U64_EQ(p.count, 3);
+  ASSERT_EQ(p.count, 3);
   scf_points_free(&p);
 }
 
@@ -207,8 +207,8 @@ static void test_counts_beyond_file(void) {
   buf_free(&b);
   scf_points_t p;
   char msg[256];
-  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), 0);
-  CHECK_U64_EQ(p.count, 3);
+  ASSERT_EQ(scf_points_read(path, &p, msg, sizeof msg), 0);
+  ASSERT_EQ(p.count, 3);
   scf_points_free(&p);
 
   static const bad_case_t text[] = {
@@ -278,7 +278,7 @@ typedef struct layout {
 
 static void piece(layout_t *l, const buf_t *b, size_t start, size_t rec_start,
                   int rec, const char *elem) {
-  CHECK(l->n < sizeof l->pieces / sizeof l->pieces[0]);
+  ASSERT(l->n < sizeof l->pieces / sizeof l->pieces[0]);
   l->pieces[l->n++] = (piece_t){start, b->n - start, rec_start, rec, elem};
 }
 
@@ -310,8 +310,8 @@ static void check_cut(const char *path, int mesh, const layout_t *l,
     int rc = mesh ? scf_mesh_read(path, &p, &tri, &nt, msg, sizeof msg)
                   : scf_points_read(path, &p, msg, sizeof msg);
     if (rc != SCF_EFORMAT && rc != SCF_EUNSUPPORTED)
-      CHECK_FAIL_("cut at %zu: %s (%s)", cut, scf_err_name(rc), msg);
-    CHECK_CONTAINS(msg, ": line ");
+      ASSERT_FAIL("cut at %zu: %s (%s)", cut, scf_err_name(rc), msg);
+    ASSERT_STR_CONTAINS(msg, ": line ");
     return;
   }
   if (generic != NULL) {
@@ -323,7 +323,7 @@ static void check_cut(const char *path, int mesh, const layout_t *l,
   for (size_t i = 0; i < l->n && pc == NULL; i++)
     if (l->pieces[i].size > 0 && l->pieces[i].start + l->pieces[i].size > cut)
       pc = &l->pieces[i];
-  CHECK(pc != NULL);
+  ASSERT(pc != NULL);
   size_t got = cut - pc->start;
   snprintf(want1, sizeof want1, "byte %zu: ", pc->start);
   if (got == 0 && pc->start == pc->rec_start)
@@ -420,10 +420,10 @@ static void test_every_cut(void) {
       uint32_t *tri;
       size_t nt;
       char msg[256];
-      CHECK_INT_EQ(scf_mesh_read(path, &p, &tri, &nt, msg, sizeof msg), 0);
-      CHECK_U64_EQ(p.count, 5);
-      CHECK_U64_EQ(nt, 4);
-      CHECK_DBL_SAME(p.xyz[13], -4.0);
+      ASSERT_EQ(scf_mesh_read(path, &p, &tri, &nt, msg, sizeof msg), 0);
+      ASSERT_EQ(p.count, 5);
+      ASSERT_EQ(nt, 4);
+      ASSERT_DBL_SAME(p.xyz[13], -4.0);
       free(tri);
       scf_points_free(&p);
       buf_free(&b);
@@ -566,7 +566,7 @@ static void test_bad_text(void) {
   path = tmp_path("longline.xyz");
   size_t n = 70000;
   char *text = malloc(n + 16);
-  CHECK(text != NULL);
+  ASSERT(text != NULL);
   memcpy(text, "1 2 3\n", 6);
   memset(text + 6, ' ', n);
   memcpy(text + 6 + n, "4 5 6\n", 6);
@@ -580,7 +580,7 @@ static void test_unreadable(void) {
   expect_fail(tmp_path("missing.ply"), 0, SCF_ENOENT, "cannot open", NULL);
   expect_fail(tmp_path("missing.obj"), 1, SCF_ENOENT, "cannot open", NULL);
   const char *dir = tmp_path("dir.xyz");
-  CHECK(mkdir(dir, 0700) == 0);
+  ASSERT(mkdir(dir, 0700) == 0);
   expect_fail(dir, 0, SCF_EIO, "is a directory", NULL);
 
   /* The extension is judged before the file is looked at. */
@@ -610,83 +610,83 @@ static void test_write_bad_index(void) {
     char name[32], msg[256];
     snprintf(name, sizeof name, "bad%d.obj", fmt);
     const char *path = tmp_path(name);
-    CHECK_INT_EQ(scf_mesh_write(path, (scf_mesh_format_t)fmt, xyz, 3, tri, 2,
+    ASSERT_EQ(scf_mesh_write(path, (scf_mesh_format_t)fmt, xyz, 3, tri, 2,
                                NULL, msg, sizeof msg),
                  SCF_EINVAL);
-    CHECK_CONTAINS(msg, path);
-    CHECK_CONTAINS(msg, "triangle 1 refers to point 3, but there are 3");
+    ASSERT_STR_CONTAINS(msg, path);
+    ASSERT_STR_CONTAINS(msg, "triangle 1 refers to point 3, but there are 3");
     struct stat st;
-    CHECK(stat(path, &st) != 0);
-    CHECK_INT_EQ(count_entries(tmp_path(""), ".tmp."), 0);
+    ASSERT(stat(path, &st) != 0);
+    ASSERT_EQ(count_entries(tmp_path(""), ".tmp."), 0);
   }
   const char *path = tmp_path("keep.ply");
   write_text(path, "old contents\n");
   char msg[256];
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, 3, tri, 2, NULL, msg,
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, 3, tri, 2, NULL, msg,
                              sizeof msg),
                SCF_EINVAL);
   char *s = read_all(path, NULL);
-  CHECK_STR_EQ(s, "old contents\n");
+  ASSERT_STR_EQ(s, "old contents\n");
   free(s);
-  CHECK_INT_EQ(count_entries(tmp_path(""), ".tmp."), 0);
+  ASSERT_EQ(count_entries(tmp_path(""), ".tmp."), 0);
 
   /* Other refusals that come before any file is created. */
-  CHECK_INT_EQ(scf_mesh_write(path, (scf_mesh_format_t)99, xyz, 3, tri, 1, NULL,
+  ASSERT_EQ(scf_mesh_write(path, (scf_mesh_format_t)99, xyz, 3, tri, 1, NULL,
                              msg, sizeof msg),
                SCF_EINVAL);
-  CHECK_CONTAINS(msg, "unknown format 99");
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_OFF, NULL, 3, tri, 1, NULL, msg,
+  ASSERT_STR_CONTAINS(msg, "unknown format 99");
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_OFF, NULL, 3, tri, 1, NULL, msg,
                              sizeof msg),
                SCF_EINVAL);
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_OFF, xyz, 3, NULL, 1, NULL, msg,
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_OFF, xyz, 3, NULL, 1, NULL, msg,
                              sizeof msg),
                SCF_EINVAL);
-  CHECK_INT_EQ(scf_mesh_write(NULL, SCF_MESH_FMT_OFF, xyz, 3, tri, 1, NULL, msg,
+  ASSERT_EQ(scf_mesh_write(NULL, SCF_MESH_FMT_OFF, xyz, 3, tri, 1, NULL, msg,
                              sizeof msg),
                SCF_EINVAL);
-  CHECK_CONTAINS(msg, "(null)");
-  CHECK_INT_EQ(scf_mesh_write(tmp_path("dir.ply/"), SCF_MESH_FMT_OFF, xyz, 3, tri,
+  ASSERT_STR_CONTAINS(msg, "(null)");
+  ASSERT_EQ(scf_mesh_write(tmp_path("dir.ply/"), SCF_MESH_FMT_OFF, xyz, 3, tri,
                              1, NULL, msg, sizeof msg),
                SCF_EINVAL);
-  CHECK_CONTAINS(msg, "not a file name");
+  ASSERT_STR_CONTAINS(msg, "not a file name");
   s = read_all(path, NULL);
-  CHECK_STR_EQ(s, "old contents\n");
+  ASSERT_STR_EQ(s, "old contents\n");
   free(s);
 }
 
 static void test_arguments(void) {
   char msg[256];
   scf_points_t p = {(double *)msg, 9};
-  CHECK_INT_EQ(scf_points_read(NULL, &p, msg, sizeof msg), SCF_EINVAL);
-  CHECK(p.xyz == NULL && p.count == 0);
-  CHECK_INT_EQ(scf_points_read("a.xyz", NULL, msg, sizeof msg), SCF_EINVAL);
-  CHECK_CONTAINS(msg, "a.xyz: NULL");
+  ASSERT_EQ(scf_points_read(NULL, &p, msg, sizeof msg), SCF_EINVAL);
+  ASSERT(p.xyz == NULL && p.count == 0);
+  ASSERT_EQ(scf_points_read("a.xyz", NULL, msg, sizeof msg), SCF_EINVAL);
+  ASSERT_STR_CONTAINS(msg, "a.xyz: NULL");
   uint32_t *tri = (uint32_t *)msg;
   size_t nt = 3;
   p = (scf_points_t){(double *)msg, 9};
-  CHECK_INT_EQ(scf_mesh_read("a.ply", &p, &tri, NULL, msg, sizeof msg),
+  ASSERT_EQ(scf_mesh_read("a.ply", &p, &tri, NULL, msg, sizeof msg),
                SCF_EINVAL);
-  CHECK(p.xyz == NULL && p.count == 0 && tri == NULL);
-  CHECK_INT_EQ(scf_mesh_read("a.ply", &p, NULL, &nt, msg, sizeof msg),
+  ASSERT(p.xyz == NULL && p.count == 0 && tri == NULL);
+  ASSERT_EQ(scf_mesh_read("a.ply", &p, NULL, &nt, msg, sizeof msg),
                SCF_EINVAL);
-  CHECK_U64_EQ(nt, 0);
+  ASSERT_EQ(nt, 0);
 
   /* Messages are cut to the buffer, and no buffer is fine. */
   const char *path = tmp_path("missing.xyz");
   char small[12];
   memset(small, 'x', sizeof small);
-  CHECK_INT_EQ(scf_points_read(path, &p, small, sizeof small), SCF_ENOENT);
-  CHECK_U64_EQ(strlen(small), sizeof small - 1);
-  CHECK(strncmp(small, path, sizeof small - 1) == 0);
-  CHECK_INT_EQ(scf_points_read(path, &p, NULL, 0), SCF_ENOENT);
+  ASSERT_EQ(scf_points_read(path, &p, small, sizeof small), SCF_ENOENT);
+  ASSERT_EQ(strlen(small), sizeof small - 1);
+  ASSERT(strncmp(small, path, sizeof small - 1) == 0);
+  ASSERT_EQ(scf_points_read(path, &p, NULL, 0), SCF_ENOENT);
   memset(small, 'x', sizeof small);
-  CHECK_INT_EQ(scf_points_read(path, &p, small, 0), SCF_ENOENT);
-  CHECK(small[0] == 'x');
+  ASSERT_EQ(scf_points_read(path, &p, small, 0), SCF_ENOENT);
+  ASSERT(small[0] == 'x');
   /* A success clears an old message. */
   write_text(tmp_path("ok.xyz"), "1 2 3\n");
   strcpy(msg, "stale");
-  CHECK_INT_EQ(scf_points_read(tmp_path("ok.xyz"), &p, msg, sizeof msg), 0);
-  CHECK_STR_EQ(msg, "");
+  ASSERT_EQ(scf_points_read(tmp_path("ok.xyz"), &p, msg, sizeof msg), 0);
+  ASSERT_STR_EQ(msg, "");
   scf_points_free(&p);
 }
 
@@ -705,15 +705,15 @@ static void test_codes(void) {
       {SCF_ENOMEM, "NOMEM", "out of memory"},
   };
   for (size_t i = 0; i < sizeof codes / sizeof codes[0]; i++) {
-    CHECK_STR_EQ(scf_err_name(codes[i].code), codes[i].name);
-    CHECK_STR_EQ(scf_strerror(codes[i].code), codes[i].text);
+    ASSERT_STR_EQ(scf_err_name(codes[i].code), codes[i].name);
+    ASSERT_STR_EQ(scf_strerror(codes[i].code), codes[i].text);
     if (i > 0)
-      CHECK_INT_EQ(codes[i].code, -100 - (int)i);
+      ASSERT_EQ(codes[i].code, -100 - (int)i);
   }
-  CHECK_STR_EQ(scf_err_name(-100), "UNKNOWN");
-  CHECK_STR_EQ(scf_err_name(-107), "UNKNOWN");
-  CHECK_STR_EQ(scf_err_name(1), "UNKNOWN");
-  CHECK_STR_EQ(scf_strerror(-107), "unknown error");
+  ASSERT_STR_EQ(scf_err_name(-100), "UNKNOWN");
+  ASSERT_STR_EQ(scf_err_name(-107), "UNKNOWN");
+  ASSERT_STR_EQ(scf_err_name(1), "UNKNOWN");
+  ASSERT_STR_EQ(scf_strerror(-107), "unknown error");
 }
 
 int main(void) {
@@ -726,5 +726,5 @@ int main(void) {
   test_write_bad_index();
   test_arguments();
   test_codes();
-  return 0;
+  return sct_finish("files_errors");
 }

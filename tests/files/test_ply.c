@@ -7,7 +7,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "check.h"
+#include "tmpdir.h"
 #include "shortcrust_files.h"
 #include "plybuf.h"
 
@@ -30,7 +30,7 @@ static void read_ok(const char *path, scf_points_t *p) {
   char msg[512];
   int rc = scf_points_read(path, p, msg, sizeof msg);
   if (rc != 0)
-    CHECK_FAIL_("reading %s: %s (%s)", path, scf_err_name(rc), msg);
+    ASSERT_FAIL("reading %s: %s (%s)", path, scf_err_name(rc), msg);
 }
 
 static void mesh_ok(const char *path, scf_points_t *p, uint32_t **tri,
@@ -38,7 +38,7 @@ static void mesh_ok(const char *path, scf_points_t *p, uint32_t **tri,
   char msg[512];
   int rc = scf_mesh_read(path, p, tri, nt, msg, sizeof msg);
   if (rc != 0)
-    CHECK_FAIL_("reading %s: %s (%s)", path, scf_err_name(rc), msg);
+    ASSERT_FAIL("reading %s: %s (%s)", path, scf_err_name(rc), msg);
 }
 
 /*
@@ -97,10 +97,10 @@ static void test_types(void) {
 
           scf_points_t p;
           read_ok(path, &p);
-          CHECK_U64_EQ(p.count, 4);
+          ASSERT_EQ(p.count, 4);
           for (int i = 0; i < 4; i++)
             for (int c = 0; c < 3; c++)
-              CHECK_DBL_SAME(p.xyz[3 * i + c],
+              ASSERT_DBL_SAME(p.xyz[3 * i + c],
                              ty_round((ty_t)t, values[t][(i + c) % 4]));
           scf_points_free(&p);
 
@@ -108,12 +108,12 @@ static void test_types(void) {
           uint32_t *tri;
           size_t nt;
           mesh_ok(path, &p, &tri, &nt);
-          CHECK_U64_EQ(p.count, 4);
-          CHECK_U64_EQ(nt, 1);
-          CHECK_U64_EQ(tri[0], 0);
-          CHECK_U64_EQ(tri[1], 1);
-          CHECK_U64_EQ(tri[2], 2);
-          CHECK_DBL_SAME(p.xyz[11], ty_round((ty_t)t, values[t][1]));
+          ASSERT_EQ(p.count, 4);
+          ASSERT_EQ(nt, 1);
+          ASSERT_EQ(tri[0], 0);
+          ASSERT_EQ(tri[1], 1);
+          ASSERT_EQ(tri[2], 2);
+          ASSERT_DBL_SAME(p.xyz[11], ty_round((ty_t)t, values[t][1]));
           free(tri);
           scf_points_free(&p);
         }
@@ -208,21 +208,21 @@ static void test_faces(void) {
         uint32_t *tri;
         size_t nt;
         mesh_ok(path, &p, &tri, &nt);
-        CHECK_U64_EQ(p.count, 5);
+        ASSERT_EQ(p.count, 5);
         for (int i = 0; i < 5; i++)
           for (int c = 0; c < 3; c++)
-            CHECK_DBL_SAME(p.xyz[3 * i + c], pyramid[i][c]);
-        CHECK_U64_EQ(nt, 6);
+            ASSERT_DBL_SAME(p.xyz[3 * i + c], pyramid[i][c]);
+        ASSERT_EQ(nt, 6);
         for (int t = 0; t < 6; t++)
           for (int c = 0; c < 3; c++)
-            CHECK_U64_EQ(tri[3 * t + c], pyramid_tris[t][c]);
+            ASSERT_EQ(tri[3 * t + c], pyramid_tris[t][c]);
         free(tri);
         scf_points_free(&p);
 
         /* As points, the faces are not even looked at. */
         read_ok(path, &p);
-        CHECK_U64_EQ(p.count, 5);
-        CHECK_DBL_SAME(p.xyz[14], 1.0);
+        ASSERT_EQ(p.count, 5);
+        ASSERT_DBL_SAME(p.xyz[14], 1.0);
         scf_points_free(&p);
       }
 }
@@ -238,10 +238,10 @@ static void test_no_faces(void) {
   uint32_t *tri = junk;
   size_t nt = 7;
   mesh_ok(path, &p, &tri, &nt);
-  CHECK_U64_EQ(p.count, 2);
-  CHECK_U64_EQ(nt, 0);
-  CHECK(tri == NULL);
-  CHECK_DBL_SAME(p.xyz[5], 6.0);
+  ASSERT_EQ(p.count, 2);
+  ASSERT_EQ(nt, 0);
+  ASSERT(tri == NULL);
+  ASSERT_DBL_SAME(p.xyz[5], 6.0);
   scf_points_free(&p);
 
   path = tmp_path("empty.ply");
@@ -250,14 +250,14 @@ static void test_no_faces(void) {
                    "element face 0\nproperty list uchar int vertex_indices\n"
                    "end_header\n");
   read_ok(path, &p);
-  CHECK_U64_EQ(p.count, 0);
-  CHECK(p.xyz == NULL);
+  ASSERT_EQ(p.count, 0);
+  ASSERT(p.xyz == NULL);
   tri = junk;
   nt = 7;
   mesh_ok(path, &p, &tri, &nt);
-  CHECK_U64_EQ(p.count, 0);
-  CHECK_U64_EQ(nt, 0);
-  CHECK(tri == NULL);
+  ASSERT_EQ(p.count, 0);
+  ASSERT_EQ(nt, 0);
+  ASSERT(tri == NULL);
   scf_points_free(&p);
 }
 
@@ -281,18 +281,18 @@ static void test_ascii_layout(void) {
   uint32_t *tri;
   size_t nt;
   mesh_ok(path, &p, &tri, &nt);
-  CHECK_U64_EQ(p.count, 3);
-  CHECK_DBL_SAME(p.xyz[0], 1.5);
-  CHECK_DBL_SAME(p.xyz[1], -2e-3);
-  CHECK_DBL_SAME(p.xyz[2], 7.0);
-  CHECK_DBL_SAME(p.xyz[3], -0.0);
-  CHECK_DBL_SAME(p.xyz[4], 1e300);
-  CHECK_DBL_SAME(p.xyz[5], 2.0);
-  CHECK(isinf(p.xyz[6]) && p.xyz[6] > 0);
-  CHECK(isnan(p.xyz[7]));
-  CHECK_DBL_SAME(p.xyz[8], 0.125);
-  CHECK_U64_EQ(nt, 1);
-  CHECK_U64_EQ(tri[2], 2);
+  ASSERT_EQ(p.count, 3);
+  ASSERT_DBL_SAME(p.xyz[0], 1.5);
+  ASSERT_DBL_SAME(p.xyz[1], -2e-3);
+  ASSERT_DBL_SAME(p.xyz[2], 7.0);
+  ASSERT_DBL_SAME(p.xyz[3], -0.0);
+  ASSERT_DBL_SAME(p.xyz[4], 1e300);
+  ASSERT_DBL_SAME(p.xyz[5], 2.0);
+  ASSERT(isinf(p.xyz[6]) && p.xyz[6] > 0);
+  ASSERT(isnan(p.xyz[7]));
+  ASSERT_DBL_SAME(p.xyz[8], 0.125);
+  ASSERT_EQ(nt, 1);
+  ASSERT_EQ(tri[2], 2);
   free(tri);
   scf_points_free(&p);
 }
@@ -337,33 +337,33 @@ static void test_large(void) {
       }
       const char *path = tmp_path("large.ply");
       buf_write(&b, path);
-      CHECK(b.n > 4 * 65536);
+      ASSERT(b.n > 4 * 65536);
       buf_free(&b);
 
       scf_points_t p;
       uint32_t *tri;
       size_t nt;
       mesh_ok(path, &p, &tri, &nt);
-      CHECK_U64_EQ(p.count, NV);
+      ASSERT_EQ(p.count, NV);
       for (int i = 0; i < NV; i++) {
-        CHECK_DBL_SAME(p.xyz[3 * i], (double)i);
-        CHECK_DBL_SAME(p.xyz[3 * i + 1], -(double)(i / 3));
-        CHECK_DBL_SAME(p.xyz[3 * i + 2], i * 0.5 + 0.25);
+        ASSERT_DBL_SAME(p.xyz[3 * i], (double)i);
+        ASSERT_DBL_SAME(p.xyz[3 * i + 1], -(double)(i / 3));
+        ASSERT_DBL_SAME(p.xyz[3 * i + 2], i * 0.5 + 0.25);
       }
       /* Odd faces are quads: two triangles each. */
-      CHECK_U64_EQ(nt, NF + NF / 2);
+      ASSERT_EQ(nt, NF + NF / 2);
       size_t t = 0;
       for (int f = 0; f < NF; f++) {
         uint32_t a = (uint32_t)f % NV, c1 = (uint32_t)(f + 1) % NV,
                  c2 = (uint32_t)(f + 2) % NV;
-        CHECK_U64_EQ(tri[3 * t], a);
-        CHECK_U64_EQ(tri[3 * t + 1], c1);
-        CHECK_U64_EQ(tri[3 * t + 2], c2);
+        ASSERT_EQ(tri[3 * t], a);
+        ASSERT_EQ(tri[3 * t + 1], c1);
+        ASSERT_EQ(tri[3 * t + 2], c2);
         t++;
         if (f % 2) {
-          CHECK_U64_EQ(tri[3 * t], a);
-          CHECK_U64_EQ(tri[3 * t + 1], c2);
-          CHECK_U64_EQ(tri[3 * t + 2], (uint32_t)(f + 3) % NV);
+          ASSERT_EQ(tri[3 * t], a);
+          ASSERT_EQ(tri[3 * t + 1], c2);
+          ASSERT_EQ(tri[3 * t + 2], (uint32_t)(f + 3) % NV);
           t++;
         }
       }
@@ -392,10 +392,10 @@ static void test_big_endian_bytes(void) {
   buf_free(&b);
   scf_points_t p;
   read_ok(path, &p);
-  CHECK_U64_EQ(p.count, 1);
-  CHECK_DBL_SAME(p.xyz[0], 1.0 + 0x1p-52);
-  CHECK_DBL_SAME(p.xyz[1], -3.141592653589793);
-  CHECK_DBL_SAME(p.xyz[2], (double)(1.0f / 3.0f));
+  ASSERT_EQ(p.count, 1);
+  ASSERT_DBL_SAME(p.xyz[0], 1.0 + 0x1p-52);
+  ASSERT_DBL_SAME(p.xyz[1], -3.141592653589793);
+  ASSERT_DBL_SAME(p.xyz[2], (double)(1.0f / 3.0f));
   scf_points_free(&p);
 
   /* The same properties reordered so that the integers carry the point. */
@@ -409,9 +409,9 @@ static void test_big_endian_bytes(void) {
   buf_write(&b, path);
   buf_free(&b);
   read_ok(path, &p);
-  CHECK_DBL_SAME(p.xyz[0], 2147483649.0);
-  CHECK_DBL_SAME(p.xyz[1], -2.0);
-  CHECK_DBL_SAME(p.xyz[2], 127.0);
+  ASSERT_DBL_SAME(p.xyz[0], 2147483649.0);
+  ASSERT_DBL_SAME(p.xyz[1], -2.0);
+  ASSERT_DBL_SAME(p.xyz[2], 127.0);
   scf_points_free(&p);
 }
 
@@ -423,5 +423,5 @@ int main(void) {
   test_ascii_layout();
   test_large();
   test_big_endian_bytes();
-  return 0;
+  return sct_finish("files_ply");
 }

@@ -5,7 +5,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "check.h"
+#include "tmpdir.h"
 #include "shortcrust_files.h"
 
 #include <math.h>
@@ -75,24 +75,24 @@ static void check_same_mesh(const char *path, int stl, int stl_float) {
   int rc = scf_mesh_read(path, &p, &t, &nt, msg, sizeof msg);
   if (rc != 0)
     fprintf(stderr, "%s\n", msg);
-  CHECK_INT_EQ(rc, 0);
-  CHECK_U64_EQ(nt, NT);
+  ASSERT_EQ(rc, 0);
+  ASSERT_EQ(nt, NT);
   if (!stl) {
-    CHECK_U64_EQ(p.count, N);
+    ASSERT_EQ(p.count, N);
     for (int i = 0; i < 3 * N; i++)
-      CHECK_DBL_SAME(p.xyz[i], xyz[i]);
+      ASSERT_DBL_SAME(p.xyz[i], xyz[i]);
     for (int i = 0; i < 3 * NT; i++)
-      CHECK_U64_EQ(t[i], tri[i]);
+      ASSERT_EQ(t[i], tri[i]);
   } else {
     /* STL repeats the vertices of every triangle. */
-    CHECK_U64_EQ(p.count, 3 * NT);
+    ASSERT_EQ(p.count, 3 * NT);
     for (int i = 0; i < 3 * NT; i++) {
-      CHECK_U64_EQ(t[i], i);
+      ASSERT_EQ(t[i], i);
       for (int c = 0; c < 3; c++) {
         double want = xyz[3 * tri[i] + c];
         if (stl_float)
           want = (double)(float)want;
-        CHECK_DBL_SAME(p.xyz[3 * i + c], want);
+        ASSERT_DBL_SAME(p.xyz[3 * i + c], want);
       }
     }
   }
@@ -101,10 +101,10 @@ static void check_same_mesh(const char *path, int stl, int stl_float) {
   if (stl)
     return;
   rc = scf_points_read(path, &p, msg, sizeof msg);
-  CHECK_INT_EQ(rc, 0);
-  CHECK_U64_EQ(p.count, N);
+  ASSERT_EQ(rc, 0);
+  ASSERT_EQ(p.count, N);
   for (int i = 0; i < 3 * N; i++)
-    CHECK_DBL_SAME(p.xyz[i], xyz[i]);
+    ASSERT_DBL_SAME(p.xyz[i], xyz[i]);
   scf_points_free(&p);
 }
 
@@ -115,17 +115,17 @@ static void check_normals(const char *path, scf_mesh_format_t fmt,
   char *s = read_all(path, &len);
   switch (fmt) {
   case SCF_MESH_FMT_PLY_BINARY: {
-    CHECK_INT_EQ(strstr(s, "property float nx\nproperty float ny\n"
+    ASSERT_EQ(strstr(s, "property float nx\nproperty float ny\n"
                            "property float nz\n") != NULL,
                  with);
     const char *body = strstr(s, "end_header\n") + strlen("end_header\n");
     size_t rec = with ? 36 : 24;
-    CHECK_U64_EQ(len, (size_t)(body - s) + N * rec + NT * 13);
+    ASSERT_EQ(len, (size_t)(body - s) + N * rec + NT * 13);
     for (int i = 0; with && i < N; i++)
       for (int c = 0; c < 3; c++) {
         float f;
         memcpy(&f, body + i * rec + 24 + 4 * c, 4);
-        CHECK_DBL_SAME((double)f, (double)(float)normals[3 * i + c]);
+        ASSERT_DBL_SAME((double)f, (double)(float)normals[3 * i + c]);
       }
     break;
   }
@@ -133,22 +133,22 @@ static void check_normals(const char *path, scf_mesh_format_t fmt,
     const char *body = strstr(s, "end_header\n") + strlen("end_header\n");
     char line[512];
     size_t ll = strcspn(body, "\n");
-    CHECK(ll < sizeof line);
+    ASSERT(ll < sizeof line);
     memcpy(line, body, ll);
     line[ll] = '\0';
     double v[6];
     int n = sscanf(line, "%lf %lf %lf %lf %lf %lf", &v[0], &v[1], &v[2],
                    &v[3], &v[4], &v[5]);
-    CHECK_INT_EQ(n, with ? 6 : 3);
+    ASSERT_EQ(n, with ? 6 : 3);
     for (int c = 0; with && c < 3; c++)
-      CHECK_DBL_SAME((double)(float)v[3 + c], (double)(float)normals[c]);
+      ASSERT_DBL_SAME((double)(float)v[3 + c], (double)(float)normals[c]);
     break;
   }
   case SCF_MESH_FMT_OBJ: {
     int vn = 0;
     for (const char *q = s; (q = strstr(q, "\nvn ")) != NULL; q++)
       vn++;
-    CHECK_INT_EQ(vn, with ? N : 0);
+    ASSERT_EQ(vn, with ? N : 0);
     char face[128];
     unsigned a = tri[0] + 1, b = tri[1] + 1, c = tri[2] + 1;
     if (with)
@@ -156,19 +156,19 @@ static void check_normals(const char *path, scf_mesh_format_t fmt,
                c, c);
     else
       snprintf(face, sizeof face, "\nf %u %u %u\n", a, b, c);
-    CHECK_CONTAINS(s, face);
+    ASSERT_STR_CONTAINS(s, face);
     if (with) {
       double q[3];
       const char *first = strstr(s, "\nvn ");
-      CHECK_INT_EQ(sscanf(first, "\nvn %lf %lf %lf", &q[0], &q[1], &q[2]), 3);
+      ASSERT_EQ(sscanf(first, "\nvn %lf %lf %lf", &q[0], &q[1], &q[2]), 3);
       for (int k = 0; k < 3; k++)
-        CHECK_DBL_NEAR(q[k], normals[k], 1e-8);
+        ASSERT_NEAR(q[k], normals[k], 1e-8);
     }
     break;
   }
   case SCF_MESH_FMT_STL_BINARY: {
-    CHECK_U64_EQ(len, 84 + 50 * (size_t)NT);
-    CHECK(memcmp(s, "solid", 5) != 0);
+    ASSERT_EQ(len, 84 + 50 * (size_t)NT);
+    ASSERT(memcmp(s, "solid", 5) != 0);
     for (int i = 0; i < NT; i++) {
       const double *a = xyz + 3 * tri[3 * i], *b = xyz + 3 * tri[3 * i + 1],
                    *c = xyz + 3 * tri[3 * i + 2];
@@ -180,7 +180,7 @@ static void check_normals(const char *path, scf_mesh_format_t fmt,
       for (int k = 0; k < 3; k++) {
         float f;
         memcpy(&f, s + 84 + 50 * i + 4 * k, 4);
-        CHECK_DBL_NEAR((double)f, n[k] / l, 1e-6);
+        ASSERT_NEAR((double)f, n[k] / l, 1e-6);
       }
     }
     break;
@@ -201,7 +201,7 @@ static void test_formats(void) {
                              with ? normals : NULL, msg, sizeof msg);
       if (rc != 0)
         fprintf(stderr, "%s\n", msg);
-      CHECK_INT_EQ(rc, 0);
+      ASSERT_EQ(rc, 0);
       int stl = formats[f].fmt == SCF_MESH_FMT_STL_BINARY ||
                 formats[f].fmt == SCF_MESH_FMT_STL_ASCII;
       check_same_mesh(path, stl, formats[f].fmt == SCF_MESH_FMT_STL_BINARY);
@@ -212,50 +212,50 @@ static void test_formats(void) {
 static void test_format_from_path(void) {
   scf_mesh_format_t fmt;
   char msg[256];
-  CHECK_INT_EQ(scf_mesh_format_from_path("a/b.ply", 0, &fmt, msg, sizeof msg),
+  ASSERT_EQ(scf_mesh_format_from_path("a/b.ply", 0, &fmt, msg, sizeof msg),
                0);
-  CHECK_INT_EQ(fmt, SCF_MESH_FMT_PLY_BINARY);
-  CHECK_INT_EQ(scf_mesh_format_from_path("b.PLY", 1, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SCF_MESH_FMT_PLY_ASCII);
-  CHECK_INT_EQ(scf_mesh_format_from_path("b.Off", 1, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SCF_MESH_FMT_OFF);
-  CHECK_INT_EQ(scf_mesh_format_from_path("b.obj", 0, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SCF_MESH_FMT_OBJ);
-  CHECK_INT_EQ(scf_mesh_format_from_path("b.stl", 0, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SCF_MESH_FMT_STL_BINARY);
-  CHECK_INT_EQ(scf_mesh_format_from_path("b.STL", 1, &fmt, msg, sizeof msg), 0);
-  CHECK_INT_EQ(fmt, SCF_MESH_FMT_STL_ASCII);
-  CHECK_INT_EQ(scf_mesh_format_from_path("out.xyz", 0, &fmt, msg, sizeof msg),
+  ASSERT_EQ(fmt, SCF_MESH_FMT_PLY_BINARY);
+  ASSERT_EQ(scf_mesh_format_from_path("b.PLY", 1, &fmt, msg, sizeof msg), 0);
+  ASSERT_EQ(fmt, SCF_MESH_FMT_PLY_ASCII);
+  ASSERT_EQ(scf_mesh_format_from_path("b.Off", 1, &fmt, msg, sizeof msg), 0);
+  ASSERT_EQ(fmt, SCF_MESH_FMT_OFF);
+  ASSERT_EQ(scf_mesh_format_from_path("b.obj", 0, &fmt, msg, sizeof msg), 0);
+  ASSERT_EQ(fmt, SCF_MESH_FMT_OBJ);
+  ASSERT_EQ(scf_mesh_format_from_path("b.stl", 0, &fmt, msg, sizeof msg), 0);
+  ASSERT_EQ(fmt, SCF_MESH_FMT_STL_BINARY);
+  ASSERT_EQ(scf_mesh_format_from_path("b.STL", 1, &fmt, msg, sizeof msg), 0);
+  ASSERT_EQ(fmt, SCF_MESH_FMT_STL_ASCII);
+  ASSERT_EQ(scf_mesh_format_from_path("out.xyz", 0, &fmt, msg, sizeof msg),
                SCF_EUNSUPPORTED);
-  CHECK_CONTAINS(msg, "out.xyz: unknown extension '.xyz'");
-  CHECK_INT_EQ(scf_mesh_format_from_path("dir.ply/out", 0, &fmt, msg,
+  ASSERT_STR_CONTAINS(msg, "out.xyz: unknown extension '.xyz'");
+  ASSERT_EQ(scf_mesh_format_from_path("dir.ply/out", 0, &fmt, msg,
                                         sizeof msg),
                SCF_EUNSUPPORTED);
-  CHECK_CONTAINS(msg, "dir.ply/out: no file extension");
+  ASSERT_STR_CONTAINS(msg, "dir.ply/out: no file extension");
 }
 
 /* AUTO follows the extension, and binary PLY is the default for .ply. */
 static void test_auto(void) {
   char msg[256];
   const char *path = tmp_path("auto.PLY");
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL,
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL,
                              msg, sizeof msg),
                0);
   char *s = read_all(path, NULL);
-  CHECK(strncmp(s, "ply\nformat binary_little_endian 1.0\n", 36) == 0);
+  ASSERT(strncmp(s, "ply\nformat binary_little_endian 1.0\n", 36) == 0);
   free(s);
   path = tmp_path("auto.obj");
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL,
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, xyz, N, tri, NT, NULL,
                              msg, sizeof msg),
                0);
   s = read_all(path, NULL);
-  CHECK(strncmp(s, "# written by shortcrust\nv ", 26) == 0);
+  ASSERT(strncmp(s, "# written by shortcrust\nv ", 26) == 0);
   free(s);
-  CHECK_INT_EQ(scf_mesh_write(tmp_path("auto.xyz"), SCF_MESH_FMT_AUTO, xyz, N,
+  ASSERT_EQ(scf_mesh_write(tmp_path("auto.xyz"), SCF_MESH_FMT_AUTO, xyz, N,
                              tri, NT, NULL, msg, sizeof msg),
                SCF_EUNSUPPORTED);
-  CHECK_CONTAINS(msg, "auto.xyz");
-  CHECK_INT_EQ(count_entries(tmp_path(""), "auto.xyz"), 0);
+  ASSERT_STR_CONTAINS(msg, "auto.xyz");
+  ASSERT_EQ(count_entries(tmp_path(""), "auto.xyz"), 0);
 }
 
 /* Points without triangles, and no points at all, are valid meshes. */
@@ -269,7 +269,7 @@ static void test_empty(void) {
                        formats[f].fmt == SCF_MESH_FMT_STL_ASCII
                    ? 0
                    : N;
-    CHECK_INT_EQ(scf_mesh_write(path, formats[f].fmt, xyz, n, NULL, 0, NULL,
+    ASSERT_EQ(scf_mesh_write(path, formats[f].fmt, xyz, n, NULL, 0, NULL,
                                msg, sizeof msg),
                  0);
     scf_points_t p;
@@ -278,20 +278,20 @@ static void test_empty(void) {
     int rc = scf_mesh_read(path, &p, &t, &nt, msg, sizeof msg);
     if (rc != 0)
       fprintf(stderr, "%s\n", msg);
-    CHECK_INT_EQ(rc, 0);
-    CHECK_U64_EQ(nt, 0);
-    CHECK(t == NULL);
-    CHECK_U64_EQ(p.count, n);
+    ASSERT_EQ(rc, 0);
+    ASSERT_EQ(nt, 0);
+    ASSERT(t == NULL);
+    ASSERT_EQ(p.count, n);
     scf_points_free(&p);
   }
   const char *path = tmp_path("nothing.ply");
-  CHECK_INT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, NULL, 0, NULL, 0, NULL,
+  ASSERT_EQ(scf_mesh_write(path, SCF_MESH_FMT_AUTO, NULL, 0, NULL, 0, NULL,
                              msg, sizeof msg),
                0);
   scf_points_t p;
-  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), 0);
-  CHECK_U64_EQ(p.count, 0);
-  CHECK(p.xyz == NULL);
+  ASSERT_EQ(scf_points_read(path, &p, msg, sizeof msg), 0);
+  ASSERT_EQ(p.count, 0);
+  ASSERT(p.xyz == NULL);
   scf_points_free(&p);
   scf_points_free(&p);
   scf_points_free(NULL);
@@ -309,19 +309,19 @@ static void test_nonfinite(void) {
   const char *names[] = {"nf.ply", "nfa.ply", "nf.off", "nf.obj"};
   for (int f = 0; f < 4; f++) {
     const char *path = tmp_path(names[f]);
-    CHECK_INT_EQ(scf_mesh_write(path, fmts[f], v, 3, t, 1, NULL, msg,
+    ASSERT_EQ(scf_mesh_write(path, fmts[f], v, 3, t, 1, NULL, msg,
                                sizeof msg),
                  0);
     scf_points_t p;
     int rc = scf_points_read(path, &p, msg, sizeof msg);
     if (rc != 0)
       fprintf(stderr, "%s\n", msg);
-    CHECK_INT_EQ(rc, 0);
-    CHECK_U64_EQ(p.count, 3);
-    CHECK(isnan(p.xyz[0]));
-    CHECK(isinf(p.xyz[3]) && p.xyz[3] > 0);
-    CHECK(isinf(p.xyz[4]) && p.xyz[4] < 0);
-    CHECK_DBL_SAME(p.xyz[8], 1.0);
+    ASSERT_EQ(rc, 0);
+    ASSERT_EQ(p.count, 3);
+    ASSERT(isnan(p.xyz[0]));
+    ASSERT(isinf(p.xyz[3]) && p.xyz[3] > 0);
+    ASSERT(isinf(p.xyz[4]) && p.xyz[4] < 0);
+    ASSERT_DBL_SAME(p.xyz[8], 1.0);
     scf_points_free(&p);
   }
 }
@@ -334,5 +334,5 @@ int main(void) {
   test_auto();
   test_empty();
   test_nonfinite();
-  return 0;
+  return sct_finish("files_roundtrip");
 }

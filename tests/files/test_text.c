@@ -7,7 +7,7 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include "check.h"
+#include "tmpdir.h"
 #include "shortcrust_files.h"
 
 #include <math.h>
@@ -16,7 +16,7 @@ static void read_ok(const char *path, scf_points_t *p) {
   char msg[512];
   int rc = scf_points_read(path, p, msg, sizeof msg);
   if (rc != 0)
-    CHECK_FAIL_("reading %s: %s (%s)", path, scf_err_name(rc), msg);
+    ASSERT_FAIL("reading %s: %s (%s)", path, scf_err_name(rc), msg);
 }
 
 static void mesh_ok(const char *path, scf_points_t *p, uint32_t **tri,
@@ -24,7 +24,7 @@ static void mesh_ok(const char *path, scf_points_t *p, uint32_t **tri,
   char msg[512];
   int rc = scf_mesh_read(path, p, tri, nt, msg, sizeof msg);
   if (rc != 0)
-    CHECK_FAIL_("reading %s: %s (%s)", path, scf_err_name(rc), msg);
+    ASSERT_FAIL("reading %s: %s (%s)", path, scf_err_name(rc), msg);
 }
 
 /* Writes text to name in the private directory and reads its points. */
@@ -35,9 +35,9 @@ static void points_of(const char *name, const char *text, scf_points_t *p) {
 }
 
 static void check_points(const scf_points_t *p, const double *want, size_t n) {
-  CHECK_U64_EQ(p->count, n);
+  ASSERT_EQ(p->count, n);
   for (size_t i = 0; i < 3 * n; i++)
-    CHECK_DBL_SAME(p->xyz[i], want[i]);
+    ASSERT_DBL_SAME(p->xyz[i], want[i]);
 }
 
 static const double three[9] = {1, 2, 3, -4.5, 5e-3, 6e10, 0.1, -0.0, 9};
@@ -91,13 +91,13 @@ static void test_pts(void) {
   const char *path = tmp_path("twocounts.pts");
   write_text(path, "2\n1 2 3\n5\n");
   char msg[256];
-  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
-  CHECK_CONTAINS(msg, "line 3");
+  ASSERT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
+  ASSERT_STR_CONTAINS(msg, "line 3");
   /* Elsewhere a lone number is a bad line, not a count. */
   path = tmp_path("count.xyz");
   write_text(path, "1\n1 2 3\n");
-  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
-  CHECK_CONTAINS(msg, "line 1");
+  ASSERT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
+  ASSERT_STR_CONTAINS(msg, "line 1");
 }
 
 /* A .csv file may open with a line of column names. */
@@ -117,14 +117,14 @@ static void test_csv(void) {
   const char *path = tmp_path("late.csv");
   write_text(path, "x,y,z\n1,2,3\nx,y,z\n");
   char msg[256];
-  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
-  CHECK_CONTAINS(msg, "line 3");
-  CHECK_CONTAINS(msg, "'x'");
+  ASSERT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
+  ASSERT_STR_CONTAINS(msg, "line 3");
+  ASSERT_STR_CONTAINS(msg, "'x'");
   /* Elsewhere a header is an error. */
   path = tmp_path("head.xyz");
   write_text(path, "x y z\n1 2 3\n");
-  CHECK_INT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
-  CHECK_CONTAINS(msg, "line 1");
+  ASSERT_EQ(scf_points_read(path, &p, msg, sizeof msg), SCF_EFORMAT);
+  ASSERT_STR_CONTAINS(msg, "line 1");
 }
 
 /* Files without points are not errors. */
@@ -135,8 +135,8 @@ static void test_no_points(void) {
   for (int i = 0; i < 4; i++) {
     scf_points_t p;
     points_of(names[i], texts[i], &p);
-    CHECK_U64_EQ(p.count, 0);
-    CHECK(p.xyz == NULL);
+    ASSERT_EQ(p.count, 0);
+    ASSERT(p.xyz == NULL);
   }
 }
 
@@ -148,18 +148,18 @@ static void test_many_lines(void) {
   enum { N = 30000 };
   const char *path = tmp_path("many.xyz");
   FILE *f = fopen(path, "wb");
-  CHECK(f != NULL);
+  ASSERT(f != NULL);
   for (int i = 0; i < N; i++)
     fprintf(f, "%d%s%.17g %d%s", i, i % 3 ? " " : ",\t", i * 0.001, -i,
             i % 7 ? "\n" : " 1 2 3 # extra\r\n");
-  CHECK(fclose(f) == 0);
+  ASSERT(fclose(f) == 0);
   scf_points_t p;
   read_ok(path, &p);
-  CHECK_U64_EQ(p.count, N);
+  ASSERT_EQ(p.count, N);
   for (int i = 0; i < N; i++) {
-    CHECK_DBL_SAME(p.xyz[3 * i], (double)i);
-    CHECK_DBL_SAME(p.xyz[3 * i + 1], i * 0.001);
-    CHECK_DBL_SAME(p.xyz[3 * i + 2], (double)-i);
+    ASSERT_DBL_SAME(p.xyz[3 * i], (double)i);
+    ASSERT_DBL_SAME(p.xyz[3 * i + 1], i * 0.001);
+    ASSERT_DBL_SAME(p.xyz[3 * i + 2], (double)-i);
   }
   scf_points_free(&p);
 }
@@ -168,10 +168,10 @@ static const double cube[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
                                   {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
 
 static void check_cube_points(const scf_points_t *p) {
-  CHECK_U64_EQ(p->count, 8);
+  ASSERT_EQ(p->count, 8);
   for (int i = 0; i < 8; i++)
     for (int c = 0; c < 3; c++)
-      CHECK_DBL_SAME(p->xyz[3 * i + c], cube[i][c]);
+      ASSERT_DBL_SAME(p->xyz[3 * i + c], cube[i][c]);
 }
 
 /* The six quads of the cube, each split at its first vertex. */
@@ -180,10 +180,10 @@ static const uint32_t cube_tris[12][3] = {
     {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
 
 static void check_cube_tris(const uint32_t *tri, size_t nt) {
-  CHECK_U64_EQ(nt, 12);
+  ASSERT_EQ(nt, 12);
   for (int t = 0; t < 12; t++)
     for (int c = 0; c < 3; c++)
-      CHECK_U64_EQ(tri[3 * t + c], cube_tris[t][c]);
+      ASSERT_EQ(tri[3 * t + c], cube_tris[t][c]);
 }
 
 static void test_off(void) {
@@ -232,7 +232,7 @@ static void test_off(void) {
   write_text(path, "OFF\n3 1 0\n1 2 3\n1 2 3\n1 2 3\n3 0 1 99\n");
   scf_points_t p;
   read_ok(path, &p);
-  CHECK_U64_EQ(p.count, 3);
+  ASSERT_EQ(p.count, 3);
   scf_points_free(&p);
 }
 
@@ -265,9 +265,9 @@ static void test_obj(void) {
   path = tmp_path("forward.obj");
   write_text(path, "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
   mesh_ok(path, &p, &tri, &nt);
-  CHECK_U64_EQ(p.count, 3);
-  CHECK_U64_EQ(nt, 1);
-  CHECK_U64_EQ(tri[2], 2);
+  ASSERT_EQ(p.count, 3);
+  ASSERT_EQ(nt, 1);
+  ASSERT_EQ(tri[2], 2);
   free(tri);
   scf_points_free(&p);
 }
@@ -300,13 +300,13 @@ static void check_stl(const char *path) {
   uint32_t *tri;
   size_t nt;
   mesh_ok(path, &p, &tri, &nt);
-  CHECK_U64_EQ(p.count, 6);
+  ASSERT_EQ(p.count, 6);
   for (int i = 0; i < 6; i++)
     for (int c = 0; c < 3; c++)
-      CHECK_DBL_SAME(p.xyz[3 * i + c], want[i][c]);
-  CHECK_U64_EQ(nt, 2);
+      ASSERT_DBL_SAME(p.xyz[3 * i + c], want[i][c]);
+  ASSERT_EQ(nt, 2);
   for (int i = 0; i < 6; i++)
-    CHECK_U64_EQ(tri[i], i);
+    ASSERT_EQ(tri[i], i);
   free(tri);
   scf_points_free(&p);
 }
@@ -343,5 +343,5 @@ int main(void) {
   test_off();
   test_obj();
   test_stl();
-  return 0;
+  return sct_finish("files_text");
 }
