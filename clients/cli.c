@@ -230,6 +230,19 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
           sc_path_name(d->path), (unsigned long long)d->boundary_samples,
           d->boundary_samples == 1 ? "" : "s",
           (unsigned long long)d->longest_loop);
+  fprintf(f, "Noise: %.2f spacings (spacing %.3g)", d->noise, d->spacing);
+  if (d->denoised)
+    fprintf(f, "; denoised%s at scale %.3g, samples moved %.2f spacings "
+               "(RMS)",
+            r->params.denoise ? "" : " by auto mode", d->denoise_scale,
+            d->denoise_shift);
+  else if (r->params.denoise && d->noise < SC_NOISE_FLOOR)
+    fprintf(f, "; below %.2f, not smoothed", SC_NOISE_FLOOR);
+  else if (r->params.denoise)
+    fprintf(f, "; not smoothed: the sample is too coarse to tell noise from "
+               "shape (curvature %.2f), give --denoise-scale to smooth",
+            d->curvature);
+  fprintf(f, ".\n");
   fprintf(f, "Time: read %.3f s", r->seconds_read);
   if (r->seconds_transfer > 0)
     fprintf(f, ", transfer %.3f s", r->seconds_transfer);

@@ -295,6 +295,9 @@ static void report_row(FILE *f, const sc_diag_info_t *row, const void *v) {
     fprintf(f, "  \"%s\": %lld,\n", row->name,
             (long long)*(const int64_t *)v);
     break;
+  case SC_DIAG_REAL:
+    fprintf(f, "  \"%s\": %.6g,\n", row->name, *(const double *)v);
+    break;
   default:
     break;
   }
@@ -303,7 +306,7 @@ static void report_row(FILE *f, const sc_diag_info_t *row, const void *v) {
 void sc_cli_report_diag(FILE *f, const sc_diag_t *d) {
   static const sc_diag_kind_t order[] = {SC_DIAG_COUNT, SC_DIAG_PATH,
                                          SC_DIAG_LOOPS, SC_DIAG_BOOL,
-                                         SC_DIAG_INT};
+                                         SC_DIAG_INT, SC_DIAG_REAL};
   size_t n;
   const sc_diag_info_t *rows = sc_diag_table(&n);
   for (size_t k = 0; k < sizeof order / sizeof order[0]; ++k)

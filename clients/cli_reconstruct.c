@@ -105,6 +105,9 @@ int sc_cmd_reconstruct(int argc, char **argv) {
       .component_count = mesh->component_count,
       .seconds_read = t_read,
   };
+  /* --smoothed-vertices: the mesh over the smoothed positions. */
+  if (mesh->smoothed)
+    memcpy(pts.xyz, mesh->smoothed, 3 * pts.count * sizeof *pts.xyz);
   status = sc_cli_job_write(&o, &progress, fmt, &pts, mesh->triangles,
                             mesh->triangle_count, mesh->normals, &res);
   sc_mesh_free(mesh);

@@ -98,6 +98,7 @@ static void diag_element(const sc_client_mesh_t *m, const sc_diag_info_t *row,
   case SC_DIAG_INT:
     *(int64_t *)field = value_i64(m, name);
     break;
+  case SC_DIAG_REAL:
   case SC_DIAG_SECONDS:
   case SC_DIAG_STAGE_SECONDS:
     ((double *)field)[i] =

@@ -258,6 +258,7 @@ extern "C" void sc_mesh_free(sc_mesh_t *mesh) {
   std::free(mesh->triangles);
   std::free(mesh->normals);
   std::free(mesh->component_genus);
+  std::free(mesh->smoothed);
   std::free(mesh);
 }
 

@@ -269,6 +269,34 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                 Progress &progress, sc_diag_t &diag,
                 uint64_t max_work = UINT64_MAX, EdgeTable *table = nullptr);
 
+// Noise (denoise.cpp; section 16).
+struct NoiseEstimate {
+  double spacing = 0;   // typical distance between neighbouring samples
+  double noise = 0;     // RMS distance to the local surface, in spacings
+  double curvature = 0; // the local surface's larger curvature x spacing
+  // Whether the sample resolves its surface, so that what the estimate
+  // calls noise is noise: noise bends the fitted surfaces too, by about
+  // half the noise, and a coarse sample (the vertices of a decimated mesh,
+  // a few hundred points on a handle) bends them much more.
+  bool resolved() const { return curvature <= 0.15 + 0.5 * noise; }
+};
+// The estimate from the neighbourhoods of a fixed subset of the points (the
+// same whatever chunks the points arrived in).
+NoiseEstimate estimate_noise(const double *xyz, size_t n, Progress &progress);
+// The smoothing radius for an estimate.
+double default_scale(const NoiseEstimate &e);
+// What smooth() did, for the diagnostics.
+struct Smoothing {
+  double scale = 0; // the neighbourhood radius used
+  double shift = 0; // RMS distance the points moved, in spacings
+};
+// Scale-space smoothing (after Digne et al. 2011): out receives a copy of
+// the points, each moved a few times onto the weighted least-squares
+// quadric of its neighbours within `scale`.
+Smoothing smooth(const double *xyz, size_t n, double scale,
+                 const NoiseEstimate &e, Progress &progress,
+                 std::vector<double> &out);
+
 // One reconstruction, fed all at once or in chunks.
 class Recon {
 public:
@@ -278,15 +306,25 @@ public:
   sc_mesh_t *finish();
 
 private:
-  void insert_range(size_t first, size_t n);
+  void insert_range(const double *xyz, size_t first, size_t n);
   // Watertight mode: closes surf; first cuts the handles that closed round
   // holes of the scan when `cut`.
   void close_surface(const double *lxyz, size_t m, bool cut,
                      Progress &progress, Surface &surf, sc_diag_t &diag);
+  // Denoising (section 16): whether insertion waits for finish(); the
+  // estimate and the smoothing, which set work_ (xyz_, or smoothed_).
+  bool defer_insertion() const;
+  void prepare(Progress &progress);
   sc_params_t params_;
   std::vector<double> own_;
   const double *xyz_ = nullptr;
   size_t n_ = 0;
+  bool prepared_ = false;
+  const double *work_ = nullptr;
+  std::vector<double> smoothed_;
+  NoiseEstimate noise_;
+  Smoothing smoothing_;
+  double seconds_denoise_ = 0;
   std::unique_ptr<Triangulator> dt_;
   double seconds_[SC_STAGE_COUNT] = {};
 };

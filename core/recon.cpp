@@ -29,6 +29,10 @@ constexpr uint64_t kMaxFillWork = 2000000000ull;
 // Closed components of fewer triangles than this, or than a thousandth of
 // the surface, are bubbles between scan layers in the modes for scans.
 constexpr size_t kMinBubble = 8;
+// Denoising (and auto mode) smooths the points when the estimated noise
+// is at least this many spacings (README, "Noise"; measured with
+// shortcrust-noise-table and on the shared closed models).
+constexpr double kNoiseFloor = SC_NOISE_FLOOR;
 
 // The box of n points (min x, y, z, then max x, y, z).
 void bounding_box(const double *xyz, size_t n, double box[6]) {
@@ -222,18 +226,47 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   diag.hole_triangles = diag.triangles > before ? diag.triangles - before : 0;
 }
 
-void Recon::insert_range(size_t first, size_t n) {
+// With --denoise the triangulation is built on the smoothed copy, which
+// needs every point. (Auto mode's choice needs them too: points that come
+// in chunks are inserted as they come, and inserted again, smoothed, only
+// if the estimate finds noise.)
+bool Recon::defer_insertion() const { return params_.denoise != 0; }
+
+// Estimates the noise and, when denoising, smooths a copy of the points;
+// work_ is then the points to triangulate (sections 16.1 to 16.3).
+void Recon::prepare(Progress &progress) {
+  Stopwatch sw;
+  prepared_ = true;
+  noise_ = estimate_noise(xyz_, n_, progress);
+  work_ = xyz_;
+  // --denoise smooths at or above the floor (see SC_NOISE_FLOOR) where the
+  // sample resolves its surface, or at any noise when given a scale; auto
+  // mode likewise without the scale.
+  const bool noisy = noise_.noise >= kNoiseFloor && noise_.resolved();
+  if ((params_.denoise && (noisy || params_.denoise_scale > 0)) ||
+      (params_.mode == SC_MODE_AUTO && noisy)) {
+    const double scale = params_.denoise_scale > 0 ? params_.denoise_scale
+                                                   : default_scale(noise_);
+    smoothing_ = smooth(xyz_, n_, scale, noise_, progress, smoothed_);
+    work_ = smoothed_.data();
+    dt_.reset(); // the raw points inserted so far
+  }
+  seconds_denoise_ = sw.lap();
+  seconds_[SC_STAGE_INPUT] += seconds_denoise_;
+}
+
+void Recon::insert_range(const double *xyz, size_t first, size_t n) {
   if (n == 0)
     return;
   Progress progress(params_.progress, params_.progress_user);
   if (!dt_) {
     double box[6];
-    bounding_box(xyz_ + 3 * first, n, box);
+    bounding_box(xyz + 3 * first, n, box);
     dt_ = make_triangulator(params_.threads, box);
   }
   Stopwatch sw;
   progress.stage(SC_STAGE_DELAUNAY);
-  dt_->insert(xyz_, first, n, progress);
+  dt_->insert(xyz, first, n, progress);
   seconds_[SC_STAGE_DELAUNAY] += sw.lap();
 }
 
@@ -247,7 +280,8 @@ void Recon::add(const double *xyz, size_t n) {
   size_t first = n_;
   n_ += n;
   seconds_[SC_STAGE_INPUT] += sw.lap();
-  insert_range(first, n);
+  if (!defer_insertion())
+    insert_range(xyz_, first, n);
 }
 
 void Recon::borrow(const double *xyz, size_t n) {
@@ -260,7 +294,8 @@ void Recon::borrow(const double *xyz, size_t n) {
   xyz_ = xyz;
   n_ = n;
   seconds_[SC_STAGE_INPUT] += sw.lap();
-  insert_range(0, n);
+  prepare(progress);
+  insert_range(work_, 0, n);
 }
 
 namespace {
@@ -373,11 +408,29 @@ sc_mesh_t *Recon::finish() {
   std::memset(&diag, 0, sizeof diag);
   diag.points_in = n_;
 
+  // The noise estimate, in every job, and the smoothing (section 16), if
+  // borrow() did not make them; as part of the insertion when points
+  // were inserted as they came.
+  if (!prepared_) {
+    if (!dt_)
+      progress.stage(SC_STAGE_INPUT);
+    prepare(progress);
+  }
+  const double *work = work_;
+  diag.spacing = noise_.spacing;
+  diag.noise = noise_.noise;
+  diag.curvature = noise_.curvature;
+  diag.denoised = work_ != xyz_;
+  diag.denoise_scale = smoothing_.scale;
+  diag.denoise_shift = smoothing_.shift;
+  diag.seconds_denoise = seconds_denoise_;
+  if (!dt_)
+    insert_range(work, 0, n_);
   check_spread(n_, dt_.get());
 
   Filtered f;
   const bool watertight = params_.mode == SC_MODE_WATERTIGHT;
-  dt_->filter(xyz_, n_, params_, progress, f, diag, seconds_);
+  dt_->filter(work, n_, params_, progress, f, diag, seconds_);
   dt_.reset();
   diag.path = params_.mode == SC_MODE_SHORTCRUST ? SC_PATH_SHORTCRUST
               : params_.mode == SC_MODE_COCONE   ? SC_PATH_COCONE
@@ -396,7 +449,7 @@ sc_mesh_t *Recon::finish() {
   const size_t m = f.to_input.size();
   std::vector<double> lxyz(3 * m);
   for (size_t k = 0; k < m; ++k)
-    std::memcpy(&lxyz[3 * k], xyz_ + 3 * size_t(f.to_input[k]),
+    std::memcpy(&lxyz[3 * k], work + 3 * size_t(f.to_input[k]),
                 3 * sizeof(double));
   std::vector<uint8_t> alive;
   EdgeTablePtr table;
@@ -451,7 +504,20 @@ sc_mesh_t *Recon::finish() {
   }
   progress.report(1.0);
 
-  return mesh_out(surf, normals, n_, diag);
+  sc_mesh_t *out = mesh_out(surf, normals, n_, diag);
+  if (params_.smoothed_vertices && diag.denoised) {
+    // Every point's smoothed position; a duplicate was smoothed as its
+    // first occurrence was (the same neighbours).
+    out->smoothed = static_cast<double *>(
+        std::malloc(std::max<size_t>(1, smoothed_.size()) * sizeof(double)));
+    if (!out->smoothed) {
+      sc_mesh_free(out);
+      throw std::bad_alloc();
+    }
+    std::memcpy(out->smoothed, smoothed_.data(),
+                smoothed_.size() * sizeof(double));
+  }
+  return out;
 }
 
 } // namespace sc

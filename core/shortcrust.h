@@ -167,6 +167,14 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    existed keeps working; so for boundary_alpha.
  *  - boundary_alpha: poles of neighbouring interior samples agree when the
  *    angle between them (unoriented) is at most this.
+ *  - denoise (every mode; docs/algorithm.md section 16): the noise is
+ *    estimated in every job; with denoise, when it is at least
+ *    SC_NOISE_FLOOR spacings, a copy of the points is smoothed toward the
+ *    surface (scale-space projection onto local quadrics) and the Delaunay
+ *    filtering runs on the copy; the triangles index the original points,
+ *    as always. denoise_scale: the smoothing radius (0: estimated);
+ *    smoothed_vertices: the mesh also carries the smoothed positions
+ *    (sc_mesh_t.smoothed). Auto mode denoises by itself above the floor.
  *  - watertight_labels: 0 closes the holes with least-area patches and
  *    labels the Delaunay cells only where the patches cannot close the
  *    surface; 1 labels the cells first (inside or outside across the
@@ -208,7 +216,20 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     0, "labels", NULL,                                                         \
     "watertight mode: close the surface by labelling Delaunay cells inside "  \
     "or outside first (default: least-area patches first, labelling where "   \
-    "they cannot close it)")
+    "they cannot close it)")                                                   \
+  X(denoise, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION, 0,         \
+    "denoise", NULL,                                                           \
+    "smooth a copy of the points toward the surface and reconstruct on it; "  \
+    "the triangles still join the original samples")                          \
+  X(denoise_scale, double, REAL, 0, 0, 1e300,                                  \
+    SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT,                                  \
+    "positive, or 0 to estimate it", OPTION, 0, "denoise-scale", "S",          \
+    "denoising: radius of the smoothing neighbourhood, in the input's units; " \
+    "given, it smooths whatever the noise")                                    \
+  X(smoothed_vertices, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", LOCAL,   \
+    0, "smoothed-vertices", NULL,                                              \
+    "denoising: give the mesh the smoothed positions of the samples instead "  \
+    "of the original ones")
 
 typedef struct sc_params {
 #define SC_PARAM_FIELD_(field, type, ...) type field;
@@ -280,8 +301,8 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
  *   X(field, type, dim, kind, wire, help)
  *
  * kind: COUNT (uint64_t), BOOL (int, 0 or 1; u64 on the wire), INT
- * (int64_t), PATH (int, an sc_path_t; u64 on the wire, its name in the
- * report), STAGE_SECONDS (double per stage; on the wire "wire.STAGE", with
+ * (int64_t), REAL (double; f64 on the wire), PATH (int, an sc_path_t; u64
+ * on the wire, its name in the report), STAGE_SECONDS (double per stage; on the wire "wire.STAGE", with
  * the names of sc_stage_name()), SECONDS (double), LOOPS (uint64_t per bin
  * of SC_LOOP_BIN_MAP; on the wire "wire.SUFFIX"). wire: the name in JOB_DONE
  * (the prefix, for the two arrays). The report names each field as the
@@ -353,7 +374,26 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
   X(handles_cut, uint64_t, , COUNT, "handles_cut",                             \
     "watertight: handles that closed round a hole, cut before closing")        \
   X(hull_facets, uint64_t, , COUNT, "hull_facets",                             \
-    "triangles of the convex hull")
+    "triangles of the convex hull")                                            \
+  X(spacing, double, , REAL, "spacing",                                        \
+    "estimated sample spacing, in the input's units")                         \
+  X(noise, double, , REAL, "noise",                                            \
+    "estimated noise: RMS distance of the samples to their local surface, in "\
+    "spacings")                                                                \
+  X(curvature, double, , REAL, "curvature",                                    \
+    "median of the local surface's larger curvature times the spacing; above " \
+    "0.15 + noise / 2 the sample is too coarse to tell noise, and denoising "  \
+    "does not smooth")                                                         \
+  X(denoised, int, , BOOL, "denoised",                                         \
+    "1 when the surface was reconstructed on a smoothed copy of the points")  \
+  X(denoise_scale, double, , REAL, "denoise_scale",                            \
+    "the smoothing neighbourhood's radius, in the input's units (0 without "  \
+    "denoising)")                                                              \
+  X(denoise_shift, double, , REAL, "denoise_shift",                            \
+    "RMS distance the smoothing moved the samples, in spacings")              \
+  X(seconds_denoise, double, , SECONDS, "seconds.denoise",                     \
+    "wall time of the noise estimate and the smoothing, in seconds (part of "  \
+    "the input stage)")
 
 typedef struct sc_diag {
 #define SC_DIAG_FIELD_(field, type, dim, kind, wire, help) type field dim;
@@ -368,6 +408,7 @@ typedef enum sc_diag_kind {
   SC_DIAG_COUNT,
   SC_DIAG_BOOL,
   SC_DIAG_INT,
+  SC_DIAG_REAL,
   SC_DIAG_PATH,
   SC_DIAG_STAGE_SECONDS,
   SC_DIAG_SECONDS,
@@ -385,6 +426,15 @@ const sc_diag_info_t *sc_diag_table(size_t *count);
 /* The wire suffix of element i of an array row ("delaunay", "3_10"); NULL
  * for a scalar row or i out of range. */
 const char *sc_diag_element_name(const sc_diag_info_t *row, size_t i);
+
+/* Denoising (params.denoise, and auto mode by itself) smooths the points
+ * only when the estimated noise (sc_diag_t.noise) is at least this many
+ * sample spacings, and the sample resolves its surface (sc_diag_t.curvature
+ * at most 0.15 + noise / 2): below the floor the Delaunay filtering needs
+ * no help, and on a coarse sample what the estimate takes for noise is the
+ * shape, which smoothing would flatten. A denoise_scale given by the
+ * caller smooths whatever the estimate. (docs/algorithm.md section 16.) */
+#define SC_NOISE_FLOOR 0.12
 
 /* Values of sc_diag_t.path: X(NAME, value, name).
  *  - SHORTCRUST: the paper's criteria.
@@ -429,6 +479,10 @@ typedef struct sc_mesh {
   int32_t *component_genus;
   size_t component_count;
   sc_diag_t diag;
+  /* With params.smoothed_vertices and denoising on: 3 * point_count
+   * coordinates, the smoothed position of each input point (a duplicate's
+   * is its first occurrence's); NULL otherwise. */
+  double *smoothed;
 } sc_mesh_t;
 
 void sc_mesh_free(sc_mesh_t *mesh);

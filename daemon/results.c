@@ -57,6 +57,7 @@ static uint32_t diag_values(const sc_diag_t *d, scp_value_t *v, uint32_t cap,
         v[n].kind = SCP_KIND_I64;
         v[n].v.i = *(const int64_t *)field;
         break;
+      case SC_DIAG_REAL:
       case SC_DIAG_SECONDS:
       case SC_DIAG_STAGE_SECONDS:
         v[n].kind = SCP_KIND_F64;

@@ -5,6 +5,9 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include <math.h>
+
+#include "shortcrust.h"
 #include "synth.h"
 
 static uint64_t splitmix64(uint64_t *x) {
@@ -37,4 +40,18 @@ uint64_t scs_rng_next(scs_rng_t *rng) {
 
 double scs_rng_uniform(scs_rng_t *rng) {
   return (double)(scs_rng_next(rng) >> 11) * 0x1.0p-53;
+}
+
+double scs_rng_gauss(scs_rng_t *rng) {
+  double u = scs_rng_uniform(rng), v = scs_rng_uniform(rng);
+  if (u < 1e-300)
+    u = 1e-300;
+  return sqrt(-2 * log(u)) * cos(2 * SC_PI * v);
+}
+
+void scs_add_noise(double *xyz, size_t n, double sigma, uint64_t seed) {
+  scs_rng_t rng;
+  scs_rng_seed(&rng, seed);
+  for (size_t i = 0; i < 3 * n; ++i)
+    xyz[i] += sigma * scs_rng_gauss(&rng);
 }

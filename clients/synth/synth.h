@@ -39,6 +39,11 @@ void scs_rng_seed(scs_rng_t *rng, uint64_t seed);
 uint64_t scs_rng_next(scs_rng_t *rng);
 /* Uniform in [0, 1), 53 random bits. */
 double scs_rng_uniform(scs_rng_t *rng);
+/* A standard normal deviate (Box-Muller). */
+double scs_rng_gauss(scs_rng_t *rng);
+/* Moves every coordinate of n points by a Gaussian of standard deviation
+ * sigma (isotropic noise), drawn from the stream of seed. */
+void scs_add_noise(double *xyz, size_t n, double sigma, uint64_t seed);
 
 /*
  * The test surfaces. All are smooth and closed; units are chosen so each

@@ -1,16 +1,17 @@
 /*
  * shortcrust-noise-table: at what noise does the output stop being a closed
- * manifold of the right genus? Well-spaced samples of the analytic test
- * surfaces, each point moved by an isotropic Gaussian of standard deviation
- * sigma (a multiple of the spacing), reconstructed in each mode; prints one
- * Markdown table and, per surface and mode, the largest sigma at which
- * every seed came out right.
+ * manifold of the right genus, with and without denoising? Well-spaced
+ * samples of the analytic test surfaces, each point moved by an isotropic
+ * Gaussian of standard deviation sigma (a multiple of the spacing),
+ * reconstructed by each run below and by CGAL's scale-space reconstruction
+ * in the same process; prints one Markdown table and, per surface and run,
+ * the largest sigma at which every seed came out right.
  *
  *   shortcrust-noise-table [--points N] [--seeds K] [--surface NAME]...
+ *                          [--no-peer]
  *
  * "Right" means: a 2-manifold, closed, consistently oriented, with the
- * surface's components and genus. Samples left out are counted but do not
- * make a result wrong (noise makes outliers).
+ * surface's components and genus, and at least 99% of the samples used.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -22,19 +23,28 @@
 #include <string.h>
 #include <time.h>
 
+#include "peer_scale_space.h"
 #include "shortcrust.h"
 #include "synth.h"
 
-
-static const double levels[] = {0, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5, 0.75, 1.0};
+static const double levels[] = {0, 0.1, 0.25, 0.33, 0.5, 0.75, 1.0};
 #define LEVEL_COUNT (sizeof levels / sizeof levels[0])
-static const int modes[] = {SC_MODE_COCONE, SC_MODE_SHORTCRUST,
-                            SC_MODE_WATERTIGHT, SC_MODE_AUTO};
-static const char *const mode_names[] = {"cocone", "shortcrust", "watertight",
-                                         "auto"};
-#define MODE_COUNT (sizeof modes / sizeof modes[0])
 
-/* A standard normal deviate (Box-Muller). */
+/* What is run on each sample: a mode with or without --denoise, or the
+ * peer (mode -1). */
+typedef struct run {
+  const char *name;
+  int mode, denoise;
+} run_t;
+static const run_t runs[] = {
+    {"watertight", SC_MODE_WATERTIGHT, 0},
+    {"watertight --denoise", SC_MODE_WATERTIGHT, 1},
+    {"cocone --denoise", SC_MODE_COCONE, 1},
+    {"auto", SC_MODE_AUTO, 0},
+    {"cgal scale-space", -1, 0},
+};
+#define RUN_COUNT (sizeof runs / sizeof runs[0])
+
 /* Wall-clock seconds, for the time column. */
 static double seconds_now(void) {
   struct timespec ts;
@@ -42,33 +52,103 @@ static double seconds_now(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static double gauss(scs_rng_t *rng) {
-  double u = scs_rng_uniform(rng), v = scs_rng_uniform(rng);
-  if (u < 1e-300)
-    u = 1e-300;
-  return sqrt(-2 * log(u)) * cos(2 * SC_PI * v);
-}
-
 static void usage(FILE *f, const char *argv0) {
   fprintf(f,
-          "usage: %s [--points N] [--seeds K] [--surface NAME]...\n"
+          "usage: %s [--points N] [--seeds K] [--surface NAME]... "
+          "[--no-peer]\n"
           "  --points N      samples per surface (default 20000)\n"
           "  --seeds K       samples of each kind, each with its own noise\n"
           "                  (default 3)\n"
           "  --surface NAME  sphere, ellipsoid, torus, genus2, two-spheres or\n"
           "                  nested-spheres; repeatable (default sphere,\n"
-          "                  torus, genus2)\n",
+          "                  torus, genus2)\n"
+          "  --no-peer       leave out CGAL's scale-space reconstruction\n",
           argv0);
+}
+
+/* The tallies of one row: a run at one noise level over every seed. */
+typedef struct tally {
+  int right, closed, failed;
+  int64_t genus_lo, genus_hi;
+  uint64_t comps_lo, comps_hi, unused;
+  double seconds, noise;
+} tally_t;
+
+static void tally_mesh(tally_t *t, const scs_surface_info_t *info, size_t n,
+                       const double *xyz, const uint32_t *tri, size_t nt) {
+  scs_meshcheck_t c;
+  if (scs_meshcheck(n, xyz, tri, nt, NULL, &c) != 0) {
+    t->failed++;
+    return;
+  }
+  t->closed += c.closed;
+  t->genus_lo = c.genus_total < t->genus_lo ? c.genus_total : t->genus_lo;
+  t->genus_hi = c.genus_total > t->genus_hi ? c.genus_total : t->genus_hi;
+  t->comps_lo = c.components < t->comps_lo ? c.components : t->comps_lo;
+  t->comps_hi = c.components > t->comps_hi ? c.components : t->comps_hi;
+  t->unused = c.samples_unused > t->unused ? c.samples_unused : t->unused;
+  t->right += c.manifold && c.closed && c.oriented &&
+              c.components == (uint64_t)info->components &&
+              c.genus_total == info->genus_total &&
+              100 * c.samples_unused <= n;
+  scs_meshcheck_free(&c);
+}
+
+/* One run on one sample, into the row's tallies. */
+static void run_one(const run_t *r, const scs_surface_info_t *info, size_t n,
+                    const double *xyz, tally_t *t) {
+  double t0 = seconds_now();
+  if (r->mode < 0) {
+    uint32_t *tri = NULL;
+    size_t nt = 0;
+    int rc = peer_scale_space(xyz, n, &tri, &nt);
+    t->seconds += seconds_now() - t0;
+    if (rc != 0)
+      t->failed++;
+    else
+      tally_mesh(t, info, n, xyz, tri, nt);
+    free(tri);
+    return;
+  }
+  sc_params_t p;
+  sc_params_init(&p);
+  p.mode = (sc_mode_t)r->mode;
+  p.denoise = r->denoise;
+  sc_mesh_t *mesh = NULL;
+  char msg[256];
+  int rc = sc_reconstruct(xyz, n, &p, &mesh, msg, sizeof msg);
+  t->seconds += seconds_now() - t0;
+  if (rc != 0) {
+    fprintf(stderr, "%s, %s: %s\n", info->name, r->name, msg);
+    t->failed++;
+    return;
+  }
+  t->noise += mesh->diag.noise;
+  tally_mesh(t, info, n, xyz, mesh->triangles, mesh->triangle_count);
+  sc_mesh_free(mesh);
+}
+
+static void range_text(char *buf, size_t len, long long lo, long long hi) {
+  if (lo > hi)
+    snprintf(buf, len, "-");
+  else if (lo == hi)
+    snprintf(buf, len, "%lld", lo);
+  else
+    snprintf(buf, len, "%lld-%lld", lo, hi);
 }
 
 int main(int argc, char **argv) {
   size_t n = 20000;
-  int seeds = 3;
+  int seeds = 3, peer = 1;
   int surfaces[SCS_SURF_COUNT], ns = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--help") == 0) {
       usage(stdout, argv[0]);
       return 0;
+    }
+    if (strcmp(argv[i], "--no-peer") == 0) {
+      peer = 0;
+      continue;
     }
     if (i + 1 >= argc) {
       fprintf(stderr, "%s: %s needs a value\n", argv[0], argv[i]);
@@ -111,117 +191,83 @@ int main(int argc, char **argv) {
     surfaces[ns++] = SCS_SURF_GENUS2;
   }
 
-  double *clean = malloc(3 * n * sizeof *clean);
   double *xyz = malloc(3 * n * sizeof *xyz);
-  if (!clean || !xyz) {
+  if (!xyz) {
     fprintf(stderr, "%s: out of memory\n", argv[0]);
     return 1;
   }
-  /* The largest level at which every seed was right, per surface and mode;
+  /* The largest level at which every seed was right, per surface and run;
    * -1 when even the clean sample was not. */
-  double limit[SCS_SURF_COUNT][MODE_COUNT];
-  printf("| surface | noise (sigma / spacing) | mode | right | closed | "
-         "genus (expected) | components | samples unused, worst | time, "
-         "mean |\n|---|--:|---|--:|--:|---|--:|--:|--:|\n");
+  double limit[SCS_SURF_COUNT][RUN_COUNT];
+  printf("| surface | noise (sigma / spacing) | estimated | run | right | "
+         "closed | genus (expected) | components | samples unused, worst | "
+         "time, mean |\n|---|--:|--:|---|--:|--:|---|--:|--:|--:|\n");
   for (int si = 0; si < ns; ++si) {
     const int s = surfaces[si];
     const scs_surface_info_t *info = scs_surface_info((scs_surface_t)s);
     const double spacing = scs_surface_spacing((scs_surface_t)s, n);
-    int failed[MODE_COUNT] = {0};
-    for (size_t m = 0; m < MODE_COUNT; ++m)
-      limit[s][m] = -1;
+    int failed[RUN_COUNT] = {0};
+    for (size_t r = 0; r < RUN_COUNT; ++r)
+      limit[s][r] = -1;
     for (size_t l = 0; l < LEVEL_COUNT; ++l) {
-      for (size_t m = 0; m < MODE_COUNT; ++m) {
-        int right = 0, closed = 0;
-        int64_t genus_lo = INT64_MAX, genus_hi = INT64_MIN;
-        uint64_t comps_lo = UINT64_MAX, comps_hi = 0, unused = 0;
-        double seconds = 0;
+      for (size_t r = 0; r < RUN_COUNT; ++r) {
+        if (runs[r].mode < 0 && !peer)
+          continue;
+        tally_t t = {.genus_lo = INT64_MAX,
+                     .genus_hi = INT64_MIN,
+                     .comps_lo = UINT64_MAX};
         for (int k = 0; k < seeds; ++k) {
           if (scs_sample_surface((scs_surface_t)s, SCS_DENSITY_UNIFORM, n,
-                                 (uint64_t)k + 1, clean) != 0) {
+                                 (uint64_t)k + 1, xyz) != 0) {
             fprintf(stderr, "%s: sampling failed\n", argv[0]);
             return 1;
           }
-          scs_rng_t rng;
-          scs_rng_seed(&rng, 1000 + (uint64_t)k);
-          const double sigma = levels[l] * spacing;
-          for (size_t i = 0; i < 3 * n; ++i)
-            xyz[i] = clean[i] + sigma * gauss(&rng);
-          sc_params_t p;
-          sc_params_init(&p);
-          p.mode = (sc_mode_t)modes[m];
-          sc_mesh_t *mesh = NULL;
-          char msg[256];
-          double t0 = seconds_now();
-          int rc = sc_reconstruct(xyz, n, &p, &mesh, msg, sizeof msg);
-          seconds += seconds_now() - t0;
-          if (rc != 0) {
-            fprintf(stderr, "%s %g %s: %s\n", info->name, levels[l],
-                    mode_names[m], msg);
-            continue;
-          }
-          scs_meshcheck_t c;
-          if (scs_meshcheck(n, xyz, mesh->triangles, mesh->triangle_count, NULL,
-                            &c) != 0) {
-            sc_mesh_free(mesh);
-            continue;
-          }
-          closed += c.closed;
-          genus_lo = c.genus_total < genus_lo ? c.genus_total : genus_lo;
-          genus_hi = c.genus_total > genus_hi ? c.genus_total : genus_hi;
-          comps_lo = c.components < comps_lo ? c.components : comps_lo;
-          comps_hi = c.components > comps_hi ? c.components : comps_hi;
-          unused = c.samples_unused > unused ? c.samples_unused : unused;
-          right += c.manifold && c.closed && c.oriented &&
-                   c.components == (uint64_t)info->components &&
-                   c.genus_total == info->genus_total;
-          scs_meshcheck_free(&c);
-          sc_mesh_free(mesh);
+          scs_add_noise(xyz, n, levels[l] * spacing, 1000 + (uint64_t)k);
+          run_one(&runs[r], info, n, xyz, &t);
         }
-        if (right == seeds && !failed[m])
-          limit[s][m] = levels[l];
+        if (t.right == seeds && !failed[r])
+          limit[s][r] = levels[l];
         else
-          failed[m] = 1;
-        char genus[64], comps[64];
-        if (genus_lo == genus_hi)
-          snprintf(genus, sizeof genus, "%lld", (long long)genus_lo);
-        else
-          snprintf(genus, sizeof genus, "%lld-%lld", (long long)genus_lo,
-                   (long long)genus_hi);
-        if (comps_lo == comps_hi)
-          snprintf(comps, sizeof comps, "%llu", (unsigned long long)comps_lo);
-        else
-          snprintf(comps, sizeof comps, "%llu-%llu",
-                   (unsigned long long)comps_lo, (unsigned long long)comps_hi);
-        printf("| %s | %.2f | %s | %d/%d | %d/%d | %s (%d) | %s | %.2f%% | "
-               "%.2f s |\n",
-               info->name, levels[l], mode_names[m], right, seeds, closed,
-               seeds, genus, info->genus_total, comps,
-               100.0 * (double)unused / (double)n, seconds / seeds);
+          failed[r] = 1;
+        char genus[64], comps[64], noise[32] = "";
+        range_text(genus, sizeof genus, t.genus_lo, t.genus_hi);
+        range_text(comps, sizeof comps, (long long)t.comps_lo,
+                   (long long)t.comps_hi);
+        if (runs[r].mode >= 0)
+          snprintf(noise, sizeof noise, "%.2f", t.noise / seeds);
+        printf("| %s | %.2f | %s | %s | %d/%d | %d/%d | %s (%d) | %s | "
+               "%.2f%% | %.2f s |\n",
+               info->name, levels[l], noise, runs[r].name, t.right, seeds,
+               t.closed, seeds, genus, info->genus_total, comps,
+               100.0 * (double)t.unused / (double)n, t.seconds / seeds);
         fflush(stdout);
       }
     }
   }
   printf("\nLargest noise (sigma / spacing) at which every seed came out "
-         "right, %zu points:\n\n| surface |", n);
-  for (size_t m = 0; m < MODE_COUNT; ++m)
-    printf(" %s |", mode_names[m]);
+         "right, %zu points, %d seeds:\n\n| surface |",
+         n, seeds);
+  for (size_t r = 0; r < RUN_COUNT; ++r)
+    if (runs[r].mode >= 0 || peer)
+      printf(" %s |", runs[r].name);
   printf("\n|---|");
-  for (size_t m = 0; m < MODE_COUNT; ++m)
-    printf("--:|");
+  for (size_t r = 0; r < RUN_COUNT; ++r)
+    if (runs[r].mode >= 0 || peer)
+      printf("--:|");
   printf("\n");
   for (int si = 0; si < ns; ++si) {
     const int s = surfaces[si];
     printf("| %s |", scs_surface_name((scs_surface_t)s));
-    for (size_t m = 0; m < MODE_COUNT; ++m) {
-      if (limit[s][m] < 0)
+    for (size_t r = 0; r < RUN_COUNT; ++r) {
+      if (runs[r].mode < 0 && !peer)
+        continue;
+      if (limit[s][r] < 0)
         printf(" none |");
       else
-        printf(" %.2f |", limit[s][m]);
+        printf(" %.2f |", limit[s][r]);
     }
     printf("\n");
   }
-  free(clean);
   free(xyz);
   return 0;
 }

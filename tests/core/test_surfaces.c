@@ -75,8 +75,9 @@ int main(int argc, char **argv) {
     return 1;
   }
   char line[512];
-  printf("%s %s %s n=%zu: %s (%.2f s)\n", argv[1], argv[2], argv[3], n,
-         scs_meshcheck_summary(&c, line, sizeof line), t1 - t0);
+  printf("%s %s %s n=%zu: %s noise=%.3f%s (%.2f s)\n", argv[1], argv[2],
+         argv[3], n, scs_meshcheck_summary(&c, line, sizeof line),
+         mesh->diag.noise, mesh->diag.denoised ? " denoised" : "", t1 - t0);
   char why[256];
   /* The modes for scans may leave out a sample or two where the boundary
    * detection sees undersampling (at most one in a thousand). */

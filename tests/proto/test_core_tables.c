@@ -77,6 +77,7 @@ static const char *diag_kind(sc_diag_kind_t k) {
   switch (k) {
   case SC_DIAG_INT:
     return "i64";
+  case SC_DIAG_REAL:
   case SC_DIAG_SECONDS:
   case SC_DIAG_STAGE_SECONDS:
     return "f64";

@@ -1,0 +1,545 @@
+// Noise: the estimate every reconstruction reports, and the scale-space
+// smoothing of a working copy of the points that denoising runs the
+// Delaunay filtering on (docs/algorithm.md section 16).
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+
+#include "internal.hpp"
+
+#include <CGAL/Orthogonal_k_neighbor_search.h>
+#include <CGAL/Search_traits_3.h>
+#include <CGAL/Search_traits_adapter.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/property_map.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace sc {
+
+namespace {
+
+typedef CGAL::Simple_cartesian<double> K;
+typedef K::Point_3 Point;
+typedef CGAL::Search_traits_3<K> BaseTraits;
+// The tree holds point numbers; their coordinates come from a vector.
+typedef CGAL::Pointer_property_map<Point>::type PointMap;
+typedef CGAL::Search_traits_adapter<uint32_t, PointMap, BaseTraits> Traits;
+typedef CGAL::Orthogonal_k_neighbor_search<Traits> Search;
+typedef Search::Tree Tree;
+typedef Search::Distance Distance;
+
+// Points whose neighbourhoods the estimate looks at: enough for a stable
+// median, few enough to cost a small fraction of the triangulation.
+constexpr size_t kEstimateSamples = 1024;
+// Neighbours of the estimate: the point and its 19 nearest, and the first
+// 10 of those.
+constexpr size_t kEstimateNeighbours = 20;
+constexpr size_t kEstimateSmall = 10;
+// Smoothing's neighbourhoods hold the points within the scale, at most
+// kMaxNeighbours of them (an even subset where more lie within: dense
+// overlaps of scans, a large scale). Fewer than kMinPoints points are
+// not smoothed.
+constexpr size_t kMinPoints = 8;
+constexpr size_t kMaxNeighbours = 48;
+// The default scale: kScaleClean spacings, and kScalePerNoise more per
+// spacing of estimated noise, up to kScaleMax; kIterations projections.
+// Measured with shortcrust-noise-table and on the merged bunny scans
+// (README, "Noise"): the registered scans need 6.5 to 9 spacings to become
+// one sheet, and beyond 8 to 9 the thin parts of the genus-2 surface at
+// 20 000 points start to fold.
+constexpr double kScaleClean = 4;
+constexpr double kScalePerNoise = 16;
+constexpr double kScaleMax = 8;
+constexpr int kIterations = 4;
+
+struct Index {
+  std::vector<Point> pts;
+  std::unique_ptr<Tree> tree;
+  Index(const double *xyz, size_t n) : pts(n) {
+    for (size_t i = 0; i < n; ++i)
+      pts[i] = Point(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    std::vector<uint32_t> ids(n);
+    for (size_t i = 0; i < n; ++i)
+      ids[i] = uint32_t(i);
+    tree.reset(new Tree(ids.begin(), ids.end(), Tree::Splitter(),
+                        Traits(CGAL::make_property_map(pts))));
+    tree->build();
+  }
+  // The k nearest points of point i (itself first, usually), nearest first,
+  // into ids and their squared distances into d2.
+  void nearest(size_t i, size_t k, uint32_t *ids, double *d2) const {
+    Distance dist(CGAL::make_property_map(const_cast<std::vector<Point> &>(pts)));
+    Search s(*tree, pts[i], unsigned(k), 0, true, dist, true);
+    size_t j = 0;
+    for (auto it = s.begin(); it != s.end() && j < k; ++it, ++j) {
+      ids[j] = it->first;
+      d2[j] = it->second;
+    }
+    for (; j < k; ++j) {
+      ids[j] = uint32_t(i);
+      d2[j] = 0;
+    }
+  }
+};
+
+// The weighted moments of points about a point p: sum w, sum w d and
+// sum w d d^T (d = point - p), from which the weighted least-squares plane
+// of the points follows.
+struct Moments {
+  double sw = 0, m1[3] = {0, 0, 0}, m2[6] = {0, 0, 0, 0, 0, 0};
+  void add(double dx, double dy, double dz, double w) {
+    sw += w;
+    m1[0] += w * dx, m1[1] += w * dy, m1[2] += w * dz;
+    m2[0] += w * dx * dx, m2[1] += w * dx * dy, m2[2] += w * dx * dz;
+    m2[3] += w * dy * dy, m2[4] += w * dy * dz, m2[5] += w * dz * dz;
+  }
+  // The plane: its centroid c (relative to p) and unit normal (the
+  // eigenvector of the covariance's smallest eigenvalue); the eigenvalues,
+  // ascending, in ev (the first is the weighted mean squared distance to
+  // the plane). False when every weight is 0.
+  bool plane(double c[3], double normal[3], double ev[3]) const {
+    if (!(sw > 0))
+      return false;
+    for (int a = 0; a < 3; ++a)
+      c[a] = m1[a] / sw;
+    Eigen::Matrix3d cov;
+    cov(0, 0) = m2[0] / sw - c[0] * c[0];
+    cov(0, 1) = cov(1, 0) = m2[1] / sw - c[0] * c[1];
+    cov(0, 2) = cov(2, 0) = m2[2] / sw - c[0] * c[2];
+    cov(1, 1) = m2[3] / sw - c[1] * c[1];
+    cov(1, 2) = cov(2, 1) = m2[4] / sw - c[1] * c[2];
+    cov(2, 2) = m2[5] / sw - c[2] * c[2];
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(cov);
+    for (int a = 0; a < 3; ++a) {
+      normal[a] = es.eigenvectors()(a, 0);
+      ev[a] = std::max(0.0, es.eigenvalues()[a]);
+    }
+    return true;
+  }
+};
+
+// Two unit tangents t1, t2 completing a unit normal to a right-handed
+// frame.
+void tangents(const double normal[3], Eigen::Vector3d &t1,
+              Eigen::Vector3d &t2) {
+  const Eigen::Vector3d nv(normal[0], normal[1], normal[2]);
+  t1 = std::fabs(nv[0]) < 0.6 ? Eigen::Vector3d(1, 0, 0)
+                              : Eigen::Vector3d(0, 1, 0);
+  t1 = (t1 - t1.dot(nv) * nv).normalized();
+  t2 = nv.cross(t1);
+}
+
+// The weighted least-squares quadric w = a + b u + c v + d u^2 + e u v +
+// f v^2 through points given in a local frame (u, v along the tangents,
+// w along the normal; u and v divided by a length near the neighbourhood's
+// size, so that the system is well conditioned).
+struct Quadric {
+  // Weighted sums of the monomials u^i v^j (i + j <= 4) and of w times
+  // those of degree at most 2: the normal equations, without forming
+  // each point's outer product.
+  double s1 = 0, su = 0, sv = 0, suu = 0, suv = 0, svv = 0, suuu = 0,
+         suuv = 0, suvv = 0, svvv = 0, suuuu = 0, suuuv = 0, suuvv = 0,
+         suvvv = 0, svvvv = 0;
+  double sw = 0, swu = 0, swv = 0, swuu = 0, swuv = 0, swvv = 0, sww = 0;
+  void add(double u, double v, double w, double weight) {
+    const double uu = u * u, uv = u * v, vv = v * v;
+    const double a = weight, aw = weight * w;
+    s1 += a, su += a * u, sv += a * v;
+    suu += a * uu, suv += a * uv, svv += a * vv;
+    suuu += a * uu * u, suuv += a * uu * v, suvv += a * u * vv,
+        svvv += a * vv * v;
+    suuuu += a * uu * uu, suuuv += a * uu * uv, suuvv += a * uu * vv,
+        suvvv += a * uv * vv, svvvv += a * vv * vv;
+    sw += aw, swu += aw * u, swv += aw * v;
+    swuu += aw * uu, swuv += aw * uv, swvv += aw * vv, sww += aw * w;
+  }
+  // The coefficients; false when the points do not determine them.
+  // bound: the largest height at the origin to believe (the
+  // neighbourhood's size).
+  bool solve(Eigen::Matrix<double, 6, 1> &beta, double bound) const {
+    Eigen::Matrix<double, 6, 6> a;
+    a << s1, su, sv, suu, suv, svv, //
+        su, suu, suv, suuu, suuv, suvv, //
+        sv, suv, svv, suuv, suvv, svvv, //
+        suu, suuu, suuv, suuuu, suuuv, suuvv, //
+        suv, suuv, suvv, suuuv, suuvv, suvvv, //
+        svv, suvv, svvv, suuvv, suvvv, svvvv;
+    // Cholesky: the matrix is positive definite when the points determine
+    // the quadric; a nearly singular one shows in an unbounded solution.
+    const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(a);
+    if (llt.info() != Eigen::Success)
+      return false;
+    Eigen::Matrix<double, 6, 1> b;
+    b << sw, swu, swv, swuu, swuv, swvv;
+    beta = llt.solve(b);
+    if (!beta.allFinite() || !(std::fabs(beta[0]) <= bound))
+      return false;
+    residual2_ = s1 > 0 ? std::max(0.0, sww - beta.dot(b)) / s1 : 0;
+    return true;
+  }
+  // The weighted mean squared residual of the last solve() (at the least-
+  // squares solution, sum w r^2 = sum w w^2 - beta . b).
+  double residual2() const { return residual2_; }
+
+private:
+  mutable double residual2_ = 0;
+};
+
+// The RMS distance of the first count points of ids (about p) to the
+// quadric that fits them best in the frame of their plane (centroid c
+// relative to p, normal): noise, without the curvature that a distance to
+// the plane would count too. Scaled by sqrt(k / (k - 6)) for the six
+// coefficients fitted; h scales u and v.
+double quadric_residual(const double *xyz, const double *p,
+                        const uint32_t *ids, size_t count, const double c[3],
+                        const double normal[3], double h,
+                        double *curvature = nullptr) {
+  Eigen::Vector3d t1, t2;
+  tangents(normal, t1, t2);
+  const Eigen::Vector3d nv(normal[0], normal[1], normal[2]);
+  const Eigen::Vector3d origin = Eigen::Vector3d(p[0], p[1], p[2]) +
+                                 Eigen::Vector3d(c[0], c[1], c[2]);
+  Quadric fit;
+  for (size_t j = 0; j < count; ++j) {
+    const double *y = xyz + 3 * size_t(ids[j]);
+    const Eigen::Vector3d d = Eigen::Vector3d(y[0], y[1], y[2]) - origin;
+    fit.add(d.dot(t1) / h, d.dot(t2) / h, d.dot(nv), 1.0);
+  }
+  Eigen::Matrix<double, 6, 1> beta;
+  if (!fit.solve(beta, 10 * h))
+    return 0;
+  if (curvature) {
+    // The larger principal curvature times h: the eigenvalues of the
+    // Hessian [2 b3, b4; b4, 2 b5] / h^2, times h.
+    const double tr = beta[3] + beta[5], det = 4 * beta[3] * beta[5] - beta[4] * beta[4];
+    const double disc = std::sqrt(std::max(0.0, tr * tr - det));
+    *curvature = (std::fabs(tr) + disc) / h;
+  }
+  const double k = double(count);
+  return std::sqrt(fit.residual2() * k / (k - 6));
+}
+
+double median(std::vector<double> &v) {
+  if (v.empty())
+    return 0;
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+} // namespace
+
+NoiseEstimate estimate_noise(const double *xyz, size_t n, Progress &progress) {
+  NoiseEstimate e;
+  if (n < kEstimateNeighbours)
+    return e;
+  Index index(xyz, n);
+  progress.report(0); // a cancel request is honoured here
+  // Points spread evenly over the input order: the same points whatever
+  // the chunks they arrived in, so that a daemon job and a local run agree.
+  const size_t samples = std::min(n, kEstimateSamples);
+  std::vector<double> noise, spacing, curv;
+  noise.reserve(samples);
+  spacing.reserve(samples);
+  uint32_t ids[kEstimateNeighbours];
+  double d2[kEstimateNeighbours];
+  for (size_t k = 0; k < samples; ++k) {
+    const size_t i = k * n / samples;
+    index.nearest(i, kEstimateNeighbours, ids, d2);
+    const double *p = xyz + 3 * i;
+    Moments m;
+    for (size_t j = 0; j < kEstimateNeighbours; ++j) {
+      const double *y = xyz + 3 * size_t(ids[j]);
+      m.add(y[0] - p[0], y[1] - p[1], y[2] - p[2], 1.0);
+    }
+    double c[3], normal[3], ev[3];
+    if (!m.plane(c, normal, ev))
+      continue;
+    // A uniform disc of k points at spacing h has a radius of
+    // h sqrt(k / pi) and a variance of h^2 k / (4 pi) along each of its
+    // two axes: the spacing from the variance in the plane.
+    const double h2 = (ev[1] + ev[2]) * 2 * SC_PI / double(kEstimateNeighbours);
+    if (!(h2 > 0))
+      continue;
+    spacing.push_back(std::sqrt(h2));
+    // At two sizes of neighbourhood, the smaller residual: noise gives
+    // about the same at both, while the curvature of a coarse sample (its
+    // third-order terms) grows with the size.
+    const double h = std::sqrt(h2);
+    double curvature = 0;
+    noise.push_back(std::min(
+        quadric_residual(xyz, p, ids, kEstimateSmall, c, normal, h),
+        quadric_residual(xyz, p, ids, kEstimateNeighbours, c, normal, h,
+                         &curvature)));
+    curv.push_back(curvature);
+  }
+  e.spacing = median(spacing);
+  e.noise = e.spacing > 0 ? median(noise) / e.spacing : 0;
+  e.curvature = median(curv);
+  return e;
+}
+
+double default_scale(const NoiseEstimate &e) {
+  return e.spacing *
+         std::min(kScaleMax, kScaleClean + kScalePerNoise * e.noise);
+}
+
+namespace {
+
+// The points in the cells of a uniform grid of a given side (or larger,
+// where the points spread over more than 2^21 - 6 sides). Cells are
+// numbered by 21-bit coordinates packed in a key, x first, so that the
+// cells of a column along z have consecutive keys; the points are sorted
+// by key.
+class Grid {
+public:
+  Grid(const double *xyz, size_t n, double side) {
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = HUGE_VAL;
+      hi[a] = -HUGE_VAL;
+    }
+    for (size_t i = 0; i < n; ++i)
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], xyz[3 * i + a]);
+        hi[a] = std::max(hi[a], xyz[3 * i + a]);
+      }
+    // At most 2^21 - 5 cells along an axis, leaving room for two
+    // neighbours on each side.
+    side_ = side;
+    for (int a = 0; a < 3; ++a) {
+      side_ = std::max(side_, (hi[a] - lo[a]) / double((1 << 21) - 6));
+      lo_[a] = lo[a] - 2 * side_;
+    }
+    order_.resize(n);
+    keys_.resize(n);
+    std::vector<std::pair<uint64_t, uint32_t>> kv(n);
+    for (size_t i = 0; i < n; ++i)
+      kv[i] = {key_of(&xyz[3 * i]), uint32_t(i)};
+    std::sort(kv.begin(), kv.end());
+    for (size_t i = 0; i < n; ++i) {
+      keys_[i] = kv[i].first;
+      order_[i] = kv[i].second;
+    }
+  }
+  uint64_t key_of(const double *p) const {
+    uint64_t key = 0;
+    for (int a = 0; a < 3; ++a)
+      key = (key << 21) | uint64_t((p[a] - lo_[a]) / side_);
+    return key;
+  }
+  // The points sorted by cell, and their keys.
+  const std::vector<uint32_t> &order() const { return order_; }
+  const std::vector<uint64_t> &keys() const { return keys_; }
+  // The range [first, last) of order() in the cell of key.
+  void cell(uint64_t key, size_t *first, size_t *last) const {
+    auto r = std::equal_range(keys_.begin(), keys_.end(), key);
+    *first = size_t(r.first - keys_.begin());
+    *last = size_t(r.second - keys_.begin());
+  }
+
+private:
+  double side_, lo_[3];
+  std::vector<uint32_t> order_;
+  std::vector<uint64_t> keys_;
+};
+
+// The neighbours of each point within r, found once, as lists of
+// positions in the grid's order (CSR: the list of point q is
+// list[first[q] .. first[q + 1])), and the points in that order.
+struct Neighbourhoods {
+  std::vector<uint32_t> order; // position -> input index
+  std::vector<size_t> first;
+  std::vector<uint32_t> list;
+};
+
+void find_neighbours(const double *xyz, size_t n, double r, Progress &progress,
+                     Neighbourhoods &nb) {
+  // Cells have half the radius as side: the ball about a point of a cell
+  // lies in the 5 x 5 x 5 cells around it, less the four columns at the
+  // corners, whose nearest point is farther than r. Each column of five
+  // cells along z is a run of consecutive keys.
+  Grid grid(xyz, n, r / 2);
+  const std::vector<uint64_t> &keys = grid.keys();
+  nb.order = grid.order();
+  std::vector<double> xs(n), ys(n), zs(n);
+  for (size_t q = 0; q < n; ++q) {
+    const double *c = &xyz[3 * size_t(nb.order[q])];
+    xs[q] = c[0], ys[q] = c[1], zs[q] = c[2];
+  }
+  const double r2 = r * r;
+  constexpr uint64_t kAxis = (uint64_t(1) << 21) - 1;
+  nb.first.assign(n + 1, 0);
+  nb.list.clear();
+  std::vector<uint32_t> found;
+  size_t ranges[21][2];
+  for (size_t first = 0; first < n;) {
+    const uint64_t key = keys[first];
+    size_t last = first;
+    while (last < n && keys[last] == key)
+      ++last;
+    const uint64_t cx = key >> 42, cy = (key >> 21) & kAxis;
+    int nr = 0;
+    for (int dx = -2; dx <= 2; ++dx)
+      for (int dy = -2; dy <= 2; ++dy) {
+        if ((dx == -2 || dx == 2) && (dy == -2 || dy == 2))
+          continue;
+        const uint64_t k0 = (uint64_t(int64_t(cx) + dx) << 42) |
+                            (uint64_t(int64_t(cy) + dy) << 21) |
+                            ((key & kAxis) - 2);
+        // Columns after this cell's start at or after it.
+        const bool after = dx > 0 || (dx == 0 && dy > 0);
+        const auto lo = std::lower_bound(
+            keys.begin() + (after ? long(first) : 0), keys.end(), k0);
+        const auto hi = std::upper_bound(lo, keys.end(), k0 + 4);
+        ranges[nr][0] = size_t(lo - keys.begin());
+        ranges[nr][1] = size_t(hi - keys.begin());
+        if (ranges[nr][0] < ranges[nr][1])
+          ++nr;
+      }
+    size_t candidates = 0;
+    for (int c = 0; c < nr; ++c)
+      candidates += ranges[c][1] - ranges[c][0];
+    if (found.size() < candidates)
+      found.resize(candidates);
+    // About half of the candidates lie within r. Where that is many
+    // times kMaxNeighbours, every stride-th candidate is looked at, an
+    // even subset from the start.
+    const size_t stride = std::max<size_t>(1, candidates / (4 * kMaxNeighbours));
+    for (size_t q = first; q < last; ++q) {
+      // Every candidate is written, and kept (k advances) when within r:
+      // no branch to mispredict.
+      size_t k = 0, skip = 0;
+      for (int c = 0; c < nr; ++c) {
+        size_t o = ranges[c][0] + skip;
+        for (; o < ranges[c][1]; o += stride) {
+          const double dx = xs[o] - xs[q], dy = ys[o] - ys[q],
+                       dz = zs[o] - zs[q];
+          found[k] = uint32_t(o);
+          k += dx * dx + dy * dy + dz * dz < r2;
+        }
+        skip = o - ranges[c][1];
+      }
+      // Where more lie within r (dense overlaps, a large scale), an even
+      // subset of them: every (k / kMaxNeighbours)-th in the order of the
+      // cells, which spreads it over the ball.
+      if (k > kMaxNeighbours) {
+        for (size_t j = 0; j < kMaxNeighbours; ++j)
+          nb.list.push_back(found[j * k / kMaxNeighbours]);
+      } else {
+        nb.list.insert(nb.list.end(), found.begin(), found.begin() + long(k));
+      }
+      nb.first[q + 1] = nb.list.size();
+    }
+    progress.tick(first, 2 * n, 1u << 12);
+    first = last;
+  }
+}
+
+
+// The weight of a neighbour at squared distance d2 from a point, for the
+// radius whose inverse square is inv: (1 - d^2 / r^2)^2, 0 beyond r.
+inline double weight(double d2, double inv) {
+  const double t = std::max(0.0, 1 - d2 * inv);
+  return t * t;
+}
+
+// Each point's unit normal: that of its neighbours' weighted plane.
+void plane_normals(const Neighbourhoods &nb, const std::vector<double> &cur,
+                   size_t n, double r, std::vector<double> &normals) {
+  const double inv = 1.0 / (r * r);
+  normals.assign(3 * n, 0.0);
+  for (size_t q = 0; q < n; ++q) {
+    const double *p = &cur[3 * q];
+    Moments m;
+    for (size_t j = nb.first[q]; j < nb.first[q + 1]; ++j) {
+      const double *y = &cur[3 * size_t(nb.list[j])];
+      const double dx = y[0] - p[0], dy = y[1] - p[1], dz = y[2] - p[2];
+      m.add(dx, dy, dz, weight(dx * dx + dy * dy + dz * dz, inv));
+    }
+    double c[3], ev[3];
+    if (!m.plane(c, &normals[3 * q], ev))
+      normals[3 * q + 2] = 1; // a lone point: any direction
+  }
+}
+
+// One step of smoothing, in the grid's order: each point of cur moved along
+// its normal onto the weighted least-squares quadric of its neighbours in
+// the frame of that normal, into next; the normal becomes the quadric's at
+// the new point. The plane alone would pull the points of a curved surface
+// inward (section 16.3).
+void project_step(const Neighbourhoods &nb, const std::vector<double> &cur,
+                  size_t n, double r, std::vector<double> &normals,
+                  std::vector<double> &next) {
+  const double inv = 1.0 / (r * r), hs = 1.0 / r;
+  for (size_t q = 0; q < n; ++q) {
+    const double *p = &cur[3 * q];
+    double *nq = &normals[3 * q];
+    Eigen::Vector3d t1, t2;
+    tangents(nq, t1, t2);
+    Quadric fit;
+    for (size_t j = nb.first[q]; j < nb.first[q + 1]; ++j) {
+      const double *y = &cur[3 * size_t(nb.list[j])];
+      const double dx = y[0] - p[0], dy = y[1] - p[1], dz = y[2] - p[2];
+      fit.add((dx * t1[0] + dy * t1[1] + dz * t1[2]) * hs,
+              (dx * t2[0] + dy * t2[1] + dz * t2[2]) * hs,
+              dx * nq[0] + dy * nq[1] + dz * nq[2],
+              weight(dx * dx + dy * dy + dz * dz, inv));
+    }
+    double *out = &next[3 * q];
+    out[0] = p[0], out[1] = p[1], out[2] = p[2];
+    Eigen::Matrix<double, 6, 1> beta;
+    if (!fit.solve(beta, r))
+      continue; // too few neighbours to say where the surface is
+    // The point over p on the quadric, and the quadric's normal there:
+    // n - (dw/du) t1 - (dw/dv) t2, with u, v in units of r.
+    Eigen::Vector3d nv(nq[0], nq[1], nq[2]);
+    for (int a = 0; a < 3; ++a)
+      out[a] += beta[0] * nv[a];
+    nv = (nv - beta[1] * hs * t1 - beta[2] * hs * t2).normalized();
+    if (nv.allFinite())
+      for (int a = 0; a < 3; ++a)
+        nq[a] = nv[a];
+  }
+}
+
+} // namespace
+
+Smoothing smooth(const double *xyz, size_t n, double scale,
+                 const NoiseEstimate &e, Progress &progress,
+                 std::vector<double> &out) {
+  Smoothing done;
+  done.scale = scale;
+  out.assign(xyz, xyz + 3 * n);
+  if (n < kMinPoints || !(e.spacing > 0) || !(scale > 0))
+    return done;
+  Neighbourhoods nb;
+  find_neighbours(xyz, n, scale, progress, nb);
+  // The points in the grid's order, smoothed there, then put back.
+  std::vector<double> cur(3 * n), next(3 * n), normals;
+  for (size_t q = 0; q < n; ++q)
+    std::memcpy(&cur[3 * q], &xyz[3 * size_t(nb.order[q])], 3 * sizeof(double));
+  plane_normals(nb, cur, n, scale, normals);
+  for (int it = 0; it < kIterations; ++it) {
+    project_step(nb, cur, n, scale, normals, next);
+    cur.swap(next);
+    progress.report(0.5 + 0.5 * double(it + 1) / kIterations);
+  }
+  double sum = 0;
+  for (size_t q = 0; q < n; ++q) {
+    double *o = &out[3 * size_t(nb.order[q])];
+    for (int a = 0; a < 3; ++a) {
+      sum += (cur[3 * q + a] - o[a]) * (cur[3 * q + a] - o[a]);
+      o[a] = cur[3 * q + a];
+    }
+  }
+  done.shift = std::sqrt(sum / double(n)) / e.spacing;
+  return done;
+}
+
+} // namespace sc
