@@ -136,8 +136,12 @@ static void usage_row(FILE *f, const param_row_t *r) {
     for (char *c = range; *c; ++c)
       if (*c == ' ')
         *c = '\1';
-    snprintf(text, sizeof text, "%s, %s (default\1%g)", r->help, range,
-             r->dflt);
+    /* A default of 0 that stands for "estimated" is said in the help. */
+    if ((r->range & SC_RANGE_ZERO_DEFAULT) && r->dflt == 0)
+      snprintf(text, sizeof text, "%s, %s", r->help, range);
+    else
+      snprintf(text, sizeof text, "%s, %s (default\1%g)", r->help, range,
+               r->dflt);
     break;
   }
   int col = fprintf(f, "%-23s", left);

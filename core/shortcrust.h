@@ -222,10 +222,10 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "smooth a copy of the points toward the surface and reconstruct on it; "  \
     "the triangles still join the original samples")                          \
   X(denoise_scale, double, REAL, 0, 0, 1e300,                                  \
-    SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT,                                  \
-    "positive, or 0 to estimate it", OPTION, 0, "denoise-scale", "S",          \
-    "denoising: radius of the smoothing neighbourhood, in the input's units; " \
-    "given, it smooths whatever the noise")                                    \
+    SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "positive", OPTION, 0,           \
+    "denoise-scale", "S",                                                      \
+    "denoising: radius of the smoothing neighbourhood, in the input's units " \
+    "(default: estimated); given, it smooths whatever the noise")             \
   X(smoothed_vertices, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", LOCAL,   \
     0, "smoothed-vertices", NULL,                                              \
     "denoising: give the mesh the smoothed positions of the samples instead "  \

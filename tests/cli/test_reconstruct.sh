@@ -1,9 +1,9 @@
 #!/bin/sh
 # The local command end to end: formats, report, exit codes and messages.
-#   test_reconstruct.sh SHORTCRUST MESHINFO DATADIR
+#   test_reconstruct.sh SHORTCRUST MESHINFO DATADIR SYNTHGEN
 # SPDX-License-Identifier: GPL-3.0-or-later
 set -u
-sc=$1 info=$2 data=$3
+sc=$1 info=$2 data=$3 synthgen=$4
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 . "$(dirname "$0")/../support/expect.sh"
@@ -11,6 +11,7 @@ trap 'rm -rf "$tmp"' EXIT
 knot=$data/knot1_points.ply
 expect 0 "usage: shortcrust reconstruct" "$sc" reconstruct --help
 for opt in --output --mode --r --theta --max-hole --paper-pruning --threads \
+           --denoise --denoise-scale --smoothed-vertices \
            --report --ascii --no-normals --quiet; do
   grep -q -- "$opt" "$tmp/out" || fail "--help does not mention $opt"
 done
@@ -44,7 +45,44 @@ done
 expect 0 "mode shortcrust (r = 0.14)" "$sc" reconstruct "$knot" -o "$tmp/s.ply" --mode shortcrust --r 0.14
 expect 0 "" "$sc" reconstruct "$knot" -o "$tmp/t.ply" --threads 2 --quiet
 
+# Noise: every summary gives the estimate; a clean sample is not smoothed
+# even with --denoise, and says why.
+expect 0 "Noise: 0.0[0-9] spacings" "$sc" reconstruct "$knot" -o "$tmp/d.ply"
+expect 0 "below 0.12, not smoothed" "$sc" reconstruct "$knot" -o "$tmp/d.ply" --denoise
+grep -q '"denoised": false' "$tmp/r.json" || fail "report lacks \"denoised\": false"
+grep -q '"noise": ' "$tmp/r.json" || fail "report lacks the noise estimate"
+# A torus with noise of half a spacing: broken without denoising, its
+# genus with it, every sample used, and auto mode denoises by itself.
+"$synthgen" torus 6000 0.5 3 "$tmp/noisy.xyz" || fail "synthgen failed"
+expect 0 "Closed 2-manifold, 1 component, genus 1; 0 samples unused" \
+  "$sc" reconstruct "$tmp/noisy.xyz" -o "$tmp/d.ply" --mode watertight --denoise \
+  --report "$tmp/dn.json"
+grep -q "; denoised at scale" "$tmp/out" || fail "--denoise did not say it smoothed: $(cat "$tmp/out")"
+grep -q '"denoised": true' "$tmp/dn.json" || fail "report lacks \"denoised\": true"
+line=$("$info" "$tmp/d.ply")
+case $line in
+  *"manifold=1 closed=1 oriented=1 components=1 genus=1 unused=0"*) ;;
+  *) fail "noisy torus with --denoise: $line" ;;
+esac
+expect 0 "denoised by auto mode" "$sc" reconstruct "$tmp/noisy.xyz" -o "$tmp/d.ply" --mode auto
+expect 0 "genus 1" "$sc" reconstruct "$tmp/noisy.xyz" -o "$tmp/d.ply" --mode auto
+# The smoothed positions instead of the samples: the same triangles.
+expect 0 "" "$sc" reconstruct "$tmp/noisy.xyz" -o "$tmp/d1.ply" --mode watertight --denoise --ascii
+expect 0 "" "$sc" reconstruct "$tmp/noisy.xyz" -o "$tmp/d2.ply" --mode watertight --denoise --ascii \
+  --smoothed-vertices
+[ "$(grep -c . "$tmp/d1.ply")" = "$(grep -c . "$tmp/d2.ply")" ] || fail "--smoothed-vertices changed the mesh's size"
+tail -n 100 "$tmp/d1.ply" > "$tmp/f1"; tail -n 100 "$tmp/d2.ply" > "$tmp/f2"
+cmp -s "$tmp/f1" "$tmp/f2" || fail "--smoothed-vertices changed the triangles"
+sed -n '/end_header/,$p' "$tmp/d1.ply" | sed -n 2p > "$tmp/v1"
+sed -n '/end_header/,$p' "$tmp/d2.ply" | sed -n 2p > "$tmp/v2"
+cmp -s "$tmp/v1" "$tmp/v2" && fail "--smoothed-vertices wrote the original positions"
+# A scale given smooths even a clean sample.
+expect 0 "denoised at scale 0.05" "$sc" reconstruct "$knot" -o "$tmp/d.ply" --denoise --denoise-scale 0.05
+
 # Bad command lines: status 2, nothing written.
+expect 2 "denoise-scale: must be positive, got -1" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --denoise --denoise-scale -1
+expect 2 "denoise-scale: 'abc' is not a finite number" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --denoise-scale abc
+expect 2 "denoise-scale: 'nan' is not a finite number" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --denoise-scale nan
 expect 2 "no input file" "$sc" reconstruct -o "$tmp/x.ply"
 expect 2 "no output file" "$sc" reconstruct "$knot"
 expect 2 "unknown mode 'foo'" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --mode foo
@@ -76,7 +114,7 @@ expect 1 "collinear" "$sc" reconstruct "$tmp/line.xyz" -o "$tmp/old.ply"
 printf 'ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0\n' > "$tmp/trunc.ply"
 expect 1 "trunc.ply" "$sc" reconstruct "$tmp/trunc.ply" -o "$tmp/old.ply"
 [ "$(cat "$tmp/old.ply")" = keep ] || fail "a failed run replaced the old output"
-ls "$tmp" | grep -q -v -E '^(old.ply|out|err|nan.xyz|line.xyz|trunc.ply|knot\..*|q.ply|r.json|s.ply|t.ply|b.ply)$' &&
+ls "$tmp" | grep -q -v -E '^(old.ply|out|err|nan.xyz|line.xyz|trunc.ply|knot\..*|q.ply|r.json|s.ply|t.ply|b.ply|d.ply|d1.ply|d2.ply|dn.json|noisy.xyz|f1|f2|v1|v2)$' &&
   fail "temporary files left: $(ls "$tmp")"
 
 [ "$fails" -eq 0 ] && echo "all passed"

@@ -3,11 +3,12 @@
 # a private socket: submit writes the same mesh as reconstruct, in every
 # format, with the same summary and report; errors give the right status
 # and say why.
-#   test_submit_cli.sh SHORTCRUST SHORTCRUSTD MESHCMP DATADIR
+#   test_submit_cli.sh SHORTCRUST SHORTCRUSTD MESHCMP DATADIR SYNTHGEN
 # SPDX-License-Identifier: GPL-3.0-or-later
 set -u
-sc=$1 scd=$2 meshcmp=$3 data=$4
+sc=$1 scd=$2 meshcmp=$3 data=$4 synthgen=$5
 . "$(dirname "$0")/daemon.sh"
+data_noisy=$tmp/noisy.xyz
 . "$(dirname "$0")/../support/expect.sh"
 
 # Before any daemon: a clear message and status 1.
@@ -30,17 +31,27 @@ expect 0 "daemon alive, protocol 1 with job options" "$sc" ping --socket "$sock"
 # The same mesh as the local command: the same vertices and the same
 # triangles, and the same summary but for the times.
 mkdir "$tmp/a" "$tmp/b"
-for in in knot1_points kitten_points; do
+# A noisy torus (half a spacing): the daemon smooths it as the local
+# command does, with --denoise and in auto mode.
+"$synthgen" torus 6000 0.5 5 "$data_noisy" || fail "synthgen failed"
+for in in knot1_points kitten_points noisy; do
   # The last two send job options; the daemon must apply them as the
   # local command does (without them the meshes differ: knot1 in boundary
   # mode has 37 small holes that --max-hole 0 leaves open).
-  for mode in "--mode cocone" "--mode shortcrust --r 0.14" "--mode auto" "--mode watertight" \
-              "--mode boundary --max-hole 0 --rho 1.2 --alpha 25" \
-              "--mode watertight --labels --paper-pruning"; do
-    expect 0 "" "$sc" submit "$data/$in.ply" -o "$tmp/a/m.ply" --socket "$sock" $mode --report "$tmp/a/r.json"
-    head -n 3 "$tmp/out" | sed "s|$tmp/a/||" > "$tmp/a/sum"
-    expect 0 "" "$sc" reconstruct "$data/$in.ply" -o "$tmp/b/m.ply" $mode --report "$tmp/b/r.json"
-    head -n 3 "$tmp/out" | sed "s|$tmp/b/||" > "$tmp/b/sum"
+  file=$data/$in.ply
+  modes="--mode_cocone --mode_shortcrust_--r_0.14 --mode_auto --mode_watertight
+         --mode_boundary_--max-hole_0_--rho_1.2_--alpha_25
+         --mode_watertight_--labels_--paper-pruning --mode_cocone_--denoise"
+  if [ "$in" = noisy ]; then
+    file=$data_noisy
+    modes="--mode_watertight_--denoise --mode_auto --mode_cocone_--denoise_--denoise-scale_0.04"
+  fi
+  for mode in $modes; do
+    mode=$(echo "$mode" | tr _ ' ')
+    expect 0 "" "$sc" submit "$file" -o "$tmp/a/m.ply" --socket "$sock" $mode --report "$tmp/a/r.json"
+    head -n 4 "$tmp/out" | sed "s|$tmp/a/||" > "$tmp/a/sum"
+    expect 0 "" "$sc" reconstruct "$file" -o "$tmp/b/m.ply" $mode --report "$tmp/b/r.json"
+    head -n 4 "$tmp/out" | sed "s|$tmp/b/||" > "$tmp/b/sum"
     "$meshcmp" "$tmp/a/m.ply" "$tmp/b/m.ply" > "$tmp/cmp" || fail "$in $mode: $(cat "$tmp/cmp")"
     # The core lists triangles in a canonical order, so the files are
     # identical byte for byte.
@@ -48,7 +59,7 @@ for in in knot1_points kitten_points; do
     cmp -s "$tmp/a/sum" "$tmp/b/sum" || fail "$in $mode: summaries differ: $(cat "$tmp/a/sum" "$tmp/b/sum")"
     # The reports agree on the parameters, the genera and every diagnostic
     # the protocol carries (PROTOCOL.md 6.12).
-    keys='"(input|params|points_in|duplicates_merged|delaunay_[a-z]*|hull_vertices|degenerate_cells|candidates|pruned|triangles|walk_rejected|holes_filled|hole_triangles|samples_unused|boundary_edges|boundary_loops|nonmanifold_[a-z]*|components|closed_components|boundary_samples|longest_loop|cells_relabelled|path|loops_by_length|closed|euler|genus|component_genus)":'
+    keys='"(input|params|points_in|duplicates_merged|spacing|noise|curvature|denoised|denoise_scale|denoise_shift|delaunay_[a-z]*|hull_vertices|degenerate_cells|candidates|pruned|triangles|walk_rejected|holes_filled|hole_triangles|samples_unused|boundary_edges|boundary_loops|nonmanifold_[a-z]*|components|closed_components|boundary_samples|longest_loop|cells_relabelled|path|loops_by_length|closed|euler|genus|component_genus)":'
     grep -E "^  $keys" "$tmp/a/r.json" > "$tmp/a/diag"
     grep -E "^  $keys" "$tmp/b/r.json" > "$tmp/b/diag"
     [ "$(wc -l < "$tmp/a/diag")" -ge 30 ] || fail "report has too few diagnostics: $(cat "$tmp/a/r.json")"
