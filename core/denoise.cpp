@@ -12,7 +12,6 @@
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/property_map.h>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -45,7 +44,7 @@ constexpr size_t kEstimateSmall = 10;
 // overlaps of scans, a large scale). Fewer than kMinPoints points are
 // not smoothed.
 constexpr size_t kMinPoints = 8;
-constexpr size_t kMaxNeighbours = 48;
+constexpr size_t kMaxNeighbours = 32;
 // The default scale: kScaleClean spacings, and kScalePerNoise more per
 // spacing of estimated noise, up to kScaleMax; kIterations projections.
 // Measured with shortcrust-noise-table and on the merged bunny scans
@@ -135,6 +134,41 @@ void tangents(const double normal[3], Eigen::Vector3d &t1,
   t2 = nv.cross(t1);
 }
 
+// Solves a x = b for a symmetric positive definite 6 x 6 matrix a
+// (Cholesky, in place in a's lower triangle): the normal equations of a
+// quadric fit, solved a million times per smoothing. False when a pivot
+// is not clearly positive: the points do not determine the quadric.
+bool cholesky_solve6(double a[6][6], const double b[6], double x[6]) {
+  for (int j = 0; j < 6; ++j) {
+    double d = a[j][j];
+    for (int k = 0; k < j; ++k)
+      d -= a[j][k] * a[j][k];
+    if (!(d > 1e-12 * a[j][j]))
+      return false;
+    d = std::sqrt(d);
+    a[j][j] = d;
+    for (int i = j + 1; i < 6; ++i) {
+      double t = a[i][j];
+      for (int k = 0; k < j; ++k)
+        t -= a[i][k] * a[j][k];
+      a[i][j] = t / d;
+    }
+  }
+  for (int i = 0; i < 6; ++i) {
+    double t = b[i];
+    for (int k = 0; k < i; ++k)
+      t -= a[i][k] * x[k];
+    x[i] = t / a[i][i];
+  }
+  for (int i = 5; i >= 0; --i) {
+    double t = x[i];
+    for (int k = i + 1; k < 6; ++k)
+      t -= a[k][i] * x[k];
+    x[i] = t / a[i][i];
+  }
+  return true;
+}
+
 // The weighted least-squares quadric w = a + b u + c v + d u^2 + e u v +
 // f v^2 through points given in a local frame (u, v along the tangents,
 // w along the normal; u and v divided by a length near the neighbourhood's
@@ -163,24 +197,24 @@ struct Quadric {
   // bound: the largest height at the origin to believe (the
   // neighbourhood's size).
   bool solve(Eigen::Matrix<double, 6, 1> &beta, double bound) const {
-    Eigen::Matrix<double, 6, 6> a;
-    a << s1, su, sv, suu, suv, svv, //
-        su, suu, suv, suuu, suuv, suvv, //
-        sv, suv, svv, suuv, suvv, svvv, //
-        suu, suuu, suuv, suuuu, suuuv, suuvv, //
-        suv, suuv, suvv, suuuv, suuvv, suvvv, //
-        svv, suvv, svvv, suuvv, suvvv, svvvv;
-    // Cholesky: the matrix is positive definite when the points determine
-    // the quadric; a nearly singular one shows in an unbounded solution.
-    const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(a);
-    if (llt.info() != Eigen::Success)
+    double a[6][6] = {{s1, su, sv, suu, suv, svv},
+                      {su, suu, suv, suuu, suuv, suvv},
+                      {sv, suv, svv, suuv, suvv, svvv},
+                      {suu, suuu, suuv, suuuu, suuuv, suuvv},
+                      {suv, suuv, suvv, suuuv, suuvv, suvvv},
+                      {svv, suvv, svvv, suuvv, suvvv, svvvv}};
+    const double b[6] = {sw, swu, swv, swuu, swuv, swvv};
+    double x[6];
+    if (!cholesky_solve6(a, b, x))
       return false;
-    Eigen::Matrix<double, 6, 1> b;
-    b << sw, swu, swv, swuu, swuv, swvv;
-    beta = llt.solve(b);
+    for (int i = 0; i < 6; ++i)
+      beta[i] = x[i];
     if (!beta.allFinite() || !(std::fabs(beta[0]) <= bound))
       return false;
-    residual2_ = s1 > 0 ? std::max(0.0, sww - beta.dot(b)) / s1 : 0;
+    double bx = 0;
+    for (int i = 0; i < 6; ++i)
+      bx += b[i] * x[i];
+    residual2_ = s1 > 0 ? std::max(0.0, sww - bx) / s1 : 0;
     return true;
   }
   // The weighted mean squared residual of the last solve() (at the least-
