@@ -181,6 +181,35 @@ struct Quadric {
          suuv = 0, suvv = 0, svvv = 0, suuuu = 0, suuuv = 0, suuvv = 0,
          suvvv = 0, svvvv = 0;
   double sw = 0, swu = 0, swv = 0, swuu = 0, swuv = 0, swvv = 0, sww = 0;
+  // Adds k points at once, from arrays: a few sums per loop, so that they
+  // stay in registers (and in vector registers: the loops are `omp simd`
+  // reductions, whose order of additions is fixed by the code).
+  void add(const double *u, const double *v, const double *w,
+           const double *weight, size_t k) {
+#pragma omp simd reduction(+ : s1, su, sv, suu, suv, svv)
+    for (size_t i = 0; i < k; ++i) {
+      const double a = weight[i], au = a * u[i], av = a * v[i];
+      s1 += a, su += au, sv += av;
+      suu += au * u[i], suv += au * v[i], svv += av * v[i];
+    }
+#pragma omp simd reduction(+ : suuu, suuv, suvv, svvv, suuuu, suuuv, suuvv,   \
+                               suvvv, svvvv)
+    for (size_t i = 0; i < k; ++i) {
+      const double uu = u[i] * u[i], vv = v[i] * v[i], uv = u[i] * v[i];
+      const double auu = weight[i] * uu, avv = weight[i] * vv;
+      suuu += auu * u[i], suuv += auu * v[i], suvv += avv * u[i],
+          svvv += avv * v[i];
+      suuuu += auu * uu, suuuv += auu * uv, suuvv += auu * vv,
+          suvvv += avv * uv, svvvv += avv * vv;
+    }
+#pragma omp simd reduction(+ : sw, swu, swv, swuu, swuv, swvv, sww)
+    for (size_t i = 0; i < k; ++i) {
+      const double aw = weight[i] * w[i], awu = aw * u[i], awv = aw * v[i];
+      sw += aw, swu += awu, swv += awv;
+      swuu += awu * u[i], swuv += awu * v[i], swvv += awv * v[i];
+      sww += aw * w[i];
+    }
+  }
   void add(double u, double v, double w, double weight) {
     const double uu = u * u, uv = u * v, vv = v * v;
     const double a = weight, aw = weight * w;
@@ -516,15 +545,21 @@ void project_step(const Neighbourhoods &nb, const std::vector<double> &cur,
     double *nq = &normals[3 * q];
     Eigen::Vector3d t1, t2;
     tangents(nq, t1, t2);
-    Quadric fit;
-    for (size_t j = nb.first[q]; j < nb.first[q + 1]; ++j) {
+    // The neighbours in the frame: u, v along the tangents (in units of
+    // r), w along the normal, and their weights.
+    double u[kMaxNeighbours], v[kMaxNeighbours], w[kMaxNeighbours],
+        wt[kMaxNeighbours];
+    size_t k = 0;
+    for (size_t j = nb.first[q]; j < nb.first[q + 1]; ++j, ++k) {
       const double *y = &cur[3 * size_t(nb.list[j])];
       const double dx = y[0] - p[0], dy = y[1] - p[1], dz = y[2] - p[2];
-      fit.add((dx * t1[0] + dy * t1[1] + dz * t1[2]) * hs,
-              (dx * t2[0] + dy * t2[1] + dz * t2[2]) * hs,
-              dx * nq[0] + dy * nq[1] + dz * nq[2],
-              weight(dx * dx + dy * dy + dz * dz, inv));
+      u[k] = (dx * t1[0] + dy * t1[1] + dz * t1[2]) * hs;
+      v[k] = (dx * t2[0] + dy * t2[1] + dz * t2[2]) * hs;
+      w[k] = dx * nq[0] + dy * nq[1] + dz * nq[2];
+      wt[k] = weight(dx * dx + dy * dy + dz * dz, inv);
     }
+    Quadric fit;
+    fit.add(u, v, w, wt, k);
     double *out = &next[3 * q];
     out[0] = p[0], out[1] = p[1], out[2] = p[2];
     Eigen::Matrix<double, 6, 1> beta;
