@@ -71,8 +71,8 @@ struct Index {
   }
   // The k nearest points of point i (itself first, usually), nearest first,
   // into ids and their squared distances into d2.
-  void nearest(size_t i, size_t k, uint32_t *ids, double *d2) const {
-    Distance dist(CGAL::make_property_map(const_cast<std::vector<Point> &>(pts)));
+  void nearest(size_t i, size_t k, uint32_t *ids, double *d2) {
+    Distance dist(CGAL::make_property_map(pts));
     Search s(*tree, pts[i], unsigned(k), 0, true, dist, true);
     size_t j = 0;
     for (auto it = s.begin(); it != s.end() && j < k; ++it, ++j) {
@@ -177,9 +177,9 @@ struct Quadric {
   // Weighted sums of the monomials u^i v^j (i + j <= 4) and of w times
   // those of degree at most 2: the normal equations, without forming
   // each point's outer product.
-  double s1 = 0, su = 0, sv = 0, suu = 0, suv = 0, svv = 0, suuu = 0,
-         suuv = 0, suvv = 0, svvv = 0, suuuu = 0, suuuv = 0, suuvv = 0,
-         suvvv = 0, svvvv = 0;
+  double s1 = 0, su = 0, sv = 0, suu = 0, suv = 0, svv = 0, suuu = 0, suuv = 0,
+         suvv = 0, svvv = 0, suuuu = 0, suuuv = 0, suuvv = 0, suvvv = 0,
+         svvvv = 0;
   double sw = 0, swu = 0, swv = 0, swuu = 0, swuv = 0, swvv = 0, sww = 0;
   // Adds k points at once, from arrays: a few sums per loop, so that they
   // stay in registers (and in vector registers: the loops are `omp simd`
@@ -259,15 +259,14 @@ private:
 // relative to p, normal): noise, without the curvature that a distance to
 // the plane would count too. Scaled by sqrt(k / (k - 6)) for the six
 // coefficients fitted; h scales u and v.
-double quadric_residual(const double *xyz, const double *p,
-                        const uint32_t *ids, size_t count, const double c[3],
-                        const double normal[3], double h,
-                        double *curvature = nullptr) {
+double quadric_residual(const double *xyz, const double *p, const uint32_t *ids,
+                        size_t count, const double c[3], const double normal[3],
+                        double h, double *curvature = nullptr) {
   Eigen::Vector3d t1, t2;
   tangents(normal, t1, t2);
   const Eigen::Vector3d nv(normal[0], normal[1], normal[2]);
-  const Eigen::Vector3d origin = Eigen::Vector3d(p[0], p[1], p[2]) +
-                                 Eigen::Vector3d(c[0], c[1], c[2]);
+  const Eigen::Vector3d origin =
+      Eigen::Vector3d(p[0], p[1], p[2]) + Eigen::Vector3d(c[0], c[1], c[2]);
   Quadric fit;
   for (size_t j = 0; j < count; ++j) {
     const double *y = xyz + 3 * size_t(ids[j]);
@@ -280,7 +279,8 @@ double quadric_residual(const double *xyz, const double *p,
   if (curvature) {
     // The larger principal curvature times h: the eigenvalues of the
     // Hessian [2 b3, b4; b4, 2 b5] / h^2, times h.
-    const double tr = beta[3] + beta[5], det = 4 * beta[3] * beta[5] - beta[4] * beta[4];
+    const double tr = beta[3] + beta[5],
+                 det = 4 * beta[3] * beta[5] - beta[4] * beta[4];
     const double disc = std::sqrt(std::max(0.0, tr * tr - det));
     *curvature = (std::fabs(tr) + disc) / h;
   }
@@ -335,10 +335,10 @@ NoiseEstimate estimate_noise(const double *xyz, size_t n, Progress &progress) {
     // third-order terms) grows with the size.
     const double h = std::sqrt(h2);
     double curvature = 0;
-    noise.push_back(std::min(
-        quadric_residual(xyz, p, ids, kEstimateSmall, c, normal, h),
-        quadric_residual(xyz, p, ids, kEstimateNeighbours, c, normal, h,
-                         &curvature)));
+    noise.push_back(
+        std::min(quadric_residual(xyz, p, ids, kEstimateSmall, c, normal, h),
+                 quadric_residual(xyz, p, ids, kEstimateNeighbours, c, normal,
+                                  h, &curvature)));
     curv.push_back(curvature);
   }
   e.spacing = median(spacing);
@@ -473,7 +473,8 @@ void find_neighbours(const double *xyz, size_t n, double r, Progress &progress,
     // About half of the candidates lie within r. Where that is many
     // times kMaxNeighbours, every stride-th candidate is looked at, an
     // even subset from the start.
-    const size_t stride = std::max<size_t>(1, candidates / (4 * kMaxNeighbours));
+    const size_t stride =
+        std::max<size_t>(1, candidates / (4 * kMaxNeighbours));
     for (size_t q = first; q < last; ++q) {
       // Every candidate is written, and kept (k advances) when within r:
       // no branch to mispredict.
@@ -503,7 +504,6 @@ void find_neighbours(const double *xyz, size_t n, double r, Progress &progress,
     first = last;
   }
 }
-
 
 // The weight of a neighbour at squared distance d2 from a point, for the
 // radius whose inverse square is inv: (1 - d^2 / r^2)^2, 0 beyond r.

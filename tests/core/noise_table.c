@@ -89,8 +89,7 @@ static void tally_mesh(tally_t *t, const scs_surface_info_t *info, size_t n,
   t->unused = c.samples_unused > t->unused ? c.samples_unused : t->unused;
   t->right += c.manifold && c.closed && c.oriented &&
               c.components == (uint64_t)info->components &&
-              c.genus_total == info->genus_total &&
-              100 * c.samples_unused <= n;
+              c.genus_total == info->genus_total && 100 * c.samples_unused <= n;
   scs_meshcheck_free(&c);
 }
 

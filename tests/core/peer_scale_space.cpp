@@ -29,8 +29,8 @@ extern "C" int peer_scale_space(const double *xyz, size_t n, uint32_t **tri,
       pts.emplace_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
     Reconstruction r(pts.begin(), pts.end());
     r.increase_scale(
-        4, CGAL::Scale_space_reconstruction_3::Weighted_PCA_smoother<K>(30,
-                                                                        200));
+        4,
+        CGAL::Scale_space_reconstruction_3::Weighted_PCA_smoother<K>(30, 200));
     r.reconstruct_surface(
         CGAL::Scale_space_reconstruction_3::Advancing_front_mesher<K>());
     const size_t count = r.number_of_facets();

@@ -106,8 +106,8 @@ int main(int argc, char **argv) {
     double before = 0, after = 0;
     for (size_t i = 0; i < n; ++i) {
       before += pow(scs_surface_distance((scs_surface_t)surf, &xyz[3 * i]), 2);
-      after += pow(scs_surface_distance((scs_surface_t)surf, &m->smoothed[3 * i]),
-                   2);
+      after += pow(
+          scs_surface_distance((scs_surface_t)surf, &m->smoothed[3 * i]), 2);
     }
     printf("RMS distance to the surface: %.3f spacings before, %.3f after\n",
            sqrt(before / n) / spacing, sqrt(after / n) / spacing);
@@ -128,8 +128,8 @@ int main(int argc, char **argv) {
     sc_recon_t *r = NULL;
     ASSERT_EQ(sc_recon_new(&q, &r), 0);
     for (size_t at = 0; at < n; at += 777)
-      EXPECT_EQ(sc_recon_add(r, xyz + 3 * at, n - at < 777 ? n - at : 777,
-                             msg, sizeof msg),
+      EXPECT_EQ(sc_recon_add(r, xyz + 3 * at, n - at < 777 ? n - at : 777, msg,
+                             sizeof msg),
                 0);
     sc_mesh_t *m3 = NULL;
     EXPECT_EQ(sc_recon_finish(r, &m3, msg, sizeof msg), 0);

@@ -24,8 +24,8 @@ int main(int argc, char **argv) {
   const uint64_t seed = strtoull(argv[4], NULL, 10);
   double *xyz = malloc(3 * n * sizeof *xyz);
   if (s < 0 || n < 4 || !xyz ||
-      scs_sample_surface((scs_surface_t)s, SCS_DENSITY_UNIFORM, n, seed,
-                         xyz) != 0) {
+      scs_sample_surface((scs_surface_t)s, SCS_DENSITY_UNIFORM, n, seed, xyz) !=
+          0) {
     fprintf(stderr, "%s: bad surface or count, or sampling failed\n", argv[0]);
     return 1;
   }
