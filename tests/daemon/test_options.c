@@ -155,6 +155,12 @@ static void options_refused(void) {
        SCP_WIRE_INVALID, "out of range"},
       {{.name = "paper_pruning", .kind = SCP_KIND_U64, .v.u = 2},
        SCP_WIRE_INVALID, "out of range"},
+      {{.name = "denoise", .kind = SCP_KIND_U64, .v.u = 2},
+       SCP_WIRE_INVALID, "out of range"},
+      {{.name = "denoise_scale", .kind = SCP_KIND_F64, .v.f = -1},
+       SCP_WIRE_INVALID, "out of range"},
+      {{.name = "denoise_scale", .kind = SCP_KIND_U64, .v.u = 1},
+       SCP_WIRE_INVALID, "must be"},
   };
   for (uint32_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
     expect_refused(c, 10 + i, cases[i].opt, cases[i].code, cases[i].says);
@@ -162,7 +168,7 @@ static void options_refused(void) {
   scp_buf_t b;
   scp_buf_init(&b, 1u << 20);
   scp_value_t one = {.name = "x", .kind = SCP_KIND_U64, .v.u = 0};
-  scp_job_begin_t m = {.job_id = 16, .mode = SCP_MODE_COCONE, .r = 0.25};
+  scp_job_begin_t m = {.job_id = 26, .mode = SCP_MODE_COCONE, .r = 0.25};
   ASSERT_MSG(scp_enc_job_begin_options(&b, &m, &one, 1) == 0, "encode");
   /* The header, then the payload: count at 40 (little-endian, as is the
    * header's payload length at 4), the entry at 48, cut off. */
@@ -176,11 +182,11 @@ static void options_refused(void) {
   scdt_frame_view(f, &v);
   scp_job_error_t e;
   EXPECT_MSG(f->type == SCP_JOB_ERROR && scp_parse_job_error(&v, &e) == 0 &&
-                 e.job_id == 16 && e.code == SCP_WIRE_INVALID,
+                 e.job_id == 26 && e.code == SCP_WIRE_INVALID,
              "empty option list: got frame type 0x%04x", f->type);
   free(f);
   scp_buf_free(&b);
-  scdt_run_ok(c, 17, SCS_SURF_SPHERE, sphere, N, T_MS, "after refusals");
+  scdt_run_ok(c, 27, SCS_SURF_SPHERE, sphere, N, T_MS, "after refusals");
   scdt_close(c);
 
   /* Options on a connection that did not agree on them: malformed. */
