@@ -242,6 +242,9 @@ struct EdgeTable {
     EdgeTable more;
     more.build(nullptr, n, added, progress, false);
     size_t i = entries.size(), j = more.entries.size();
+    // Exactly the room needed: a table is appended to once or twice, and
+    // resize() alone would double the largest array of the closing step.
+    entries.reserve(i + j);
     entries.resize(i + j);
     for (size_t out = entries.size(); j > 0; --out) {
       // Of equal keys the new entries go last.
