@@ -135,36 +135,41 @@ void tangents(const double normal[3], Eigen::Vector3d &t1,
 }
 
 // Solves a x = b for a symmetric positive definite 6 x 6 matrix a
-// (Cholesky, in place in a's lower triangle): the normal equations of a
-// quadric fit, solved a million times per smoothing. False when a pivot
-// is not clearly positive: the points do not determine the quadric.
-bool cholesky_solve6(double a[6][6], const double b[6], double x[6]) {
+// (a = L D L^T, L in place in a's lower triangle): the normal equations of a
+// quadric fit, solved a million times per smoothing, with one division per
+// column and no square root. False when a pivot is not clearly positive: the
+// points do not determine the quadric.
+bool ldlt_solve6(double a[6][6], const double b[6], double x[6]) {
+  double d[6], inv[6];
   for (int j = 0; j < 6; ++j) {
-    double d = a[j][j];
-    for (int k = 0; k < j; ++k)
-      d -= a[j][k] * a[j][k];
-    if (!(d > 1e-12 * a[j][j]))
+    double w[6]; // row j of L times D
+    double dj = a[j][j];
+    for (int k = 0; k < j; ++k) {
+      w[k] = a[j][k] * d[k];
+      dj -= a[j][k] * w[k];
+    }
+    if (!(dj > 1e-12 * a[j][j]))
       return false;
-    d = std::sqrt(d);
-    a[j][j] = d;
+    d[j] = dj;
+    inv[j] = 1 / dj;
     for (int i = j + 1; i < 6; ++i) {
       double t = a[i][j];
       for (int k = 0; k < j; ++k)
-        t -= a[i][k] * a[j][k];
-      a[i][j] = t / d;
+        t -= a[i][k] * w[k];
+      a[i][j] = t * inv[j];
     }
   }
   for (int i = 0; i < 6; ++i) {
     double t = b[i];
     for (int k = 0; k < i; ++k)
       t -= a[i][k] * x[k];
-    x[i] = t / a[i][i];
+    x[i] = t;
   }
   for (int i = 5; i >= 0; --i) {
-    double t = x[i];
+    double t = x[i] * inv[i];
     for (int k = i + 1; k < 6; ++k)
       t -= a[k][i] * x[k];
-    x[i] = t / a[i][i];
+    x[i] = t;
   }
   return true;
 }
@@ -234,7 +239,7 @@ struct Quadric {
                       {svv, suvv, svvv, suuvv, suvvv, svvvv}};
     const double b[6] = {sw, swu, swv, swuu, swuv, swvv};
     double x[6];
-    if (!cholesky_solve6(a, b, x))
+    if (!ldlt_solve6(a, b, x))
       return false;
     for (int i = 0; i < 6; ++i)
       beta[i] = x[i];
