@@ -443,7 +443,10 @@ void find_neighbours(const double *xyz, size_t n, double r, Progress &progress,
   const double r2 = r * r;
   constexpr uint64_t kAxis = (uint64_t(1) << 21) - 1;
   nb.first.assign(n + 1, 0);
+  // At most kMaxNeighbours each: room for all, so that the list is never
+  // copied as it grows.
   nb.list.clear();
+  nb.list.reserve(n * kMaxNeighbours);
   std::vector<uint32_t> found;
   size_t ranges[21][2];
   for (size_t first = 0; first < n;) {
