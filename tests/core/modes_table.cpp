@@ -1,6 +1,6 @@
-// shortcrust-modes-table: every mode of the core, and CGAL's advancing-front
-// reconstruction beside them, on real point files; prints one Markdown
-// table.
+// shortcrust-modes-table: every mode of the core, boundary and watertight
+// modes with denoising too, and CGAL's advancing-front reconstruction
+// beside them, on real point files; prints one Markdown table.
 //
 //   shortcrust-modes-table DATA_DIR [FILE ...]
 //
@@ -8,11 +8,11 @@
 // default is the list below. For each file and method: triangles, samples
 // used (vertices / distinct points), non-manifold edges and vertices,
 // orientation errors, boundary loops, components, closed or not, genus
-// summed over the components (open ones included), the distance from the output to the ground-truth
-// mesh where there is one (RMS and maximum over the triangle centroids and
-// vertices, point to triangle, in units of the file's median sample
-// spacing), and the time beside CGAL's Delaunay triangulation of the same
-// points.
+// summed over the components (open ones included), the distance from the output
+// to the ground-truth mesh where there is one (RMS and maximum over the
+// triangle centroids and vertices, point to triangle, in units of the file's
+// median sample spacing), and the time beside CGAL's Delaunay triangulation of
+// the same points.
 //
 // SPDX-License-Identifier: GPL-3.0-or-later
 
@@ -40,8 +40,8 @@
 #include <malloc.h>
 #endif
 
-#include "shortcrust_files.h"
 #include "shortcrust.h"
+#include "shortcrust_files.h"
 #include "synth.h"
 
 namespace {
@@ -90,7 +90,8 @@ void distance(const Reference &ref, const double *xyz, const uint32_t *t,
     max = std::max(max, std::sqrt(d2));
   };
   for (size_t i = 0; i < nt; ++i) {
-    const double *a = xyz + 3 * size_t(t[3 * i]), *b = xyz + 3 * size_t(t[3 * i + 1]),
+    const double *a = xyz + 3 * size_t(t[3 * i]),
+                 *b = xyz + 3 * size_t(t[3 * i + 1]),
                  *c = xyz + 3 * size_t(t[3 * i + 2]);
     add(Point((a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3,
               (a[2] + b[2] + c[2]) / 3));
@@ -125,10 +126,9 @@ double median_spacing(const std::vector<Point> &pts) {
   return nn.empty() ? 1 : nn[nn.size() / 2];
 }
 
-void row(const char *file, const char *method, const char *path,
-         size_t points, const uint32_t *t, size_t nt, const double *xyz,
-         const Reference *ref, double spacing, double seconds,
-         double dt_seconds) {
+void row(const char *file, const char *method, const char *path, size_t points,
+         const uint32_t *t, size_t nt, const double *xyz, const Reference *ref,
+         double spacing, double seconds, double dt_seconds) {
   scs_meshcheck_t c;
   if (scs_meshcheck(points, xyz, t, nt, nullptr, &c) != 0) {
     std::printf("| %s | %s | meshcheck failed |\n", file, method);
@@ -148,17 +148,15 @@ void row(const char *file, const char *method, const char *path,
     std::snprintf(dist, sizeof dist, "%.2f / %.1f", rms / spacing,
                   max / spacing);
   }
-  std::printf("| %s | %s | %s | %zu | %.2f%% | %llu / %llu | %llu | %llu | "
-              "%llu | %s | %lld | %s | %.2f s | %.2f |\n",
-              file, method, path, nt,
-              100.0 * double(c.vertices_used) / double(points),
-              (unsigned long long)c.nonmanifold_edges,
-              (unsigned long long)c.nonmanifold_vertices,
-              (unsigned long long)c.orientation_errors,
-              (unsigned long long)c.boundary_loops,
-              (unsigned long long)c.components, c.closed ? "yes" : "no",
-              genus, dist, seconds,
-              seconds / dt_seconds);
+  std::printf(
+      "| %s | %s | %s | %zu | %.2f%% | %llu / %llu | %llu | %llu | "
+      "%llu | %s | %lld | %s | %.2f s | %.2f |\n",
+      file, method, path, nt, 100.0 * double(c.vertices_used) / double(points),
+      (unsigned long long)c.nonmanifold_edges,
+      (unsigned long long)c.nonmanifold_vertices,
+      (unsigned long long)c.orientation_errors,
+      (unsigned long long)c.boundary_loops, (unsigned long long)c.components,
+      c.closed ? "yes" : "no", genus, dist, seconds, seconds / dt_seconds);
   std::fflush(stdout);
   scs_meshcheck_free(&c);
 }
@@ -171,10 +169,19 @@ int measure(const std::string &dir, const std::string &name, int repeat,
   // kMinYardstick seconds.)
   const double kMinYardstick = 0.25;
   const int kMaxRounds = 1000;
-  const sc_mode_t modes[] = {SC_MODE_COCONE, SC_MODE_BOUNDARY,
-                             SC_MODE_WATERTIGHT, SC_MODE_AUTO};
-  const char *const mode_names[] = {"cocone", "boundary", "watertight",
-                                    "auto"};
+  // Every mode, and the modes for scans again with denoising (section 16
+  // of docs/algorithm.md: multi-view scans need it).
+  struct Method {
+    sc_mode_t mode;
+    int denoise;
+    const char *name;
+  };
+  const Method methods[] = {{SC_MODE_COCONE, 0, "cocone"},
+                            {SC_MODE_BOUNDARY, 0, "boundary"},
+                            {SC_MODE_WATERTIGHT, 0, "watertight"},
+                            {SC_MODE_AUTO, 0, "auto"},
+                            {SC_MODE_BOUNDARY, 1, "boundary --denoise"},
+                            {SC_MODE_WATERTIGHT, 1, "watertight --denoise"}};
   char msg[512];
   scf_points_t pts;
   std::string path = dir + "/" + name + ".ply";
@@ -185,12 +192,11 @@ int measure(const std::string &dir, const std::string &name, int repeat,
   std::vector<Point> points;
   points.reserve(pts.count);
   for (size_t i = 0; i < pts.count; ++i)
-    points.emplace_back(pts.xyz[3 * i], pts.xyz[3 * i + 1],
-                        pts.xyz[3 * i + 2]);
+    points.emplace_back(pts.xyz[3 * i], pts.xyz[3 * i + 1], pts.xyz[3 * i + 2]);
 
   // The yardstick, CGAL's Delaunay triangulation of the same points
   // inserted as a range, and every mode, in rounds.
-  const size_t nmodes = sizeof modes / sizeof modes[0];
+  const size_t nmodes = sizeof methods / sizeof methods[0];
   double t0 = 0, dt_seconds = HUGE_VAL, dt_total = 0;
   std::vector<double> best(nmodes, HUGE_VAL);
   std::vector<sc_mesh_t *> meshes(nmodes, nullptr);
@@ -213,13 +219,14 @@ int measure(const std::string &dir, const std::string &name, int repeat,
         continue;
       sc_params_t p;
       sc_params_init(&p);
-      p.mode = modes[m];
+      p.mode = methods[m].mode;
+      p.denoise = methods[m].denoise;
       sc_mesh_free(meshes[m]);
       meshes[m] = nullptr;
       cold_heap();
       t0 = now();
-      rc[m] = sc_reconstruct(pts.xyz, pts.count, &p, &meshes[m], msg,
-                             sizeof msg);
+      rc[m] =
+          sc_reconstruct(pts.xyz, pts.count, &p, &meshes[m], msg, sizeof msg);
       best[m] = std::min(best[m], now() - t0);
       if (rc[m] != 0)
         failure[m] = msg;
@@ -229,9 +236,9 @@ int measure(const std::string &dir, const std::string &name, int repeat,
 
   // The ground truth, where there is one.
   std::unique_ptr<Reference> ref;
-  std::string gt = name.rfind("bunny", 0) == 0 ? "bunny_gt_mesh"
+  std::string gt = name.rfind("bunny", 0) == 0         ? "bunny_gt_mesh"
                    : name.rfind("cgal_kitten", 0) == 0 ? "kitten_gt_mesh"
-                                                        : "";
+                                                       : "";
   if (!gt.empty()) {
     scf_points_t gp;
     uint32_t *gt_tri = nullptr;
@@ -259,14 +266,14 @@ int measure(const std::string &dir, const std::string &name, int repeat,
 
   for (size_t m = 0; m < nmodes; ++m) {
     if (rc[m] != 0) {
-      std::printf("| %s | %s | failed: %s |\n", name.c_str(), mode_names[m],
+      std::printf("| %s | %s | failed: %s |\n", name.c_str(), methods[m].name,
                   failure[m].c_str());
       continue;
     }
     const sc_mesh_t *mesh = meshes[m];
-    row(name.c_str(), mode_names[m], sc_path_name(mesh->diag.path),
-        pts.count, mesh->triangles, mesh->triangle_count, pts.xyz,
-        ref.get(), spacing, best[m], dt_seconds);
+    row(name.c_str(), methods[m].name, sc_path_name(mesh->diag.path), pts.count,
+        mesh->triangles, mesh->triangle_count, pts.xyz, ref.get(), spacing,
+        best[m], dt_seconds);
     sc_mesh_free(meshes[m]);
   }
 
@@ -277,8 +284,8 @@ int measure(const std::string &dir, const std::string &name, int repeat,
   // CGAL's advancing-front reconstruction with its defaults.
   std::vector<std::array<std::size_t, 3>> facets;
   t0 = now();
-  CGAL::advancing_front_surface_reconstruction(
-      points.begin(), points.end(), std::back_inserter(facets));
+  CGAL::advancing_front_surface_reconstruction(points.begin(), points.end(),
+                                               std::back_inserter(facets));
   double sec = now() - t0;
   std::vector<uint32_t> t;
   t.reserve(3 * facets.size());
@@ -302,7 +309,8 @@ int main(int argc, char **argv) {
                               std::strcmp(argv[1], "-h") == 0);
     std::fprintf(help ? stdout : stderr,
                  "usage: %s DATA_DIR [--repeat N] [--no-afsr] [FILE ...]\n\n"
-                 "Runs every mode and CGAL's advancing front on the point "
+                 "Runs every mode (boundary and watertight also with --denoise)"
+                 "\nand CGAL's advancing front on the point "
                  "files\nDATA_DIR/FILE.ply (default: the bunny scans, "
                  "cgal_kitten_normals\nand cgal_half) and prints one "
                  "Markdown table. Each mode's time and that\nof CGAL's "
