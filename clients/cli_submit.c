@@ -256,6 +256,10 @@ int sc_cmd_submit(int argc, char **argv) {
       .seconds_read = t_read,
       .seconds_transfer = mesh.seconds_upload + mesh.seconds_download,
   };
+  /* --smoothed-vertices: the mesh over the positions the daemon smoothed,
+   * as `reconstruct` writes it; none came when nothing was smoothed. */
+  if (mesh.vertices)
+    memcpy(pts.xyz, mesh.vertices, 3 * pts.count * sizeof *pts.xyz);
   status = sc_cli_job_write(&o, &progress, fmt, &pts, mesh.triangles,
                             (size_t)mesh.triangle_count, mesh.normals, &res);
   sc_client_job_free(job);

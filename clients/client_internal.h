@@ -46,6 +46,8 @@ struct sc_client_job {
   uint64_t ntri, tri_cap;
   double *normals;
   uint64_t nnormals;
+  double *vertices; /* VERTICES, when params.smoothed_vertices */
+  uint64_t nvertices;
   int32_t *genus;
   uint64_t ncomp, comp_cap;
   sc_client_value_t *values;

@@ -31,6 +31,7 @@ void scc_job_destroy(sc_client_job_t *j) {
   free(j->own_xyz);
   free(j->tri);
   free(j->normals);
+  free(j->vertices);
   free(j->genus);
   free(j->values);
   free(j);
@@ -95,9 +96,11 @@ void scc_settle(sc_client_t *c, sc_client_job_t *j, int status) {
 void scc_drop_mesh(sc_client_job_t *j) {
   free(j->tri);
   free(j->normals);
+  free(j->vertices);
   free(j->genus);
   j->tri = NULL;
   j->normals = NULL;
+  j->vertices = NULL;
   j->genus = NULL;
   j->tri_cap = j->comp_cap = 0;
 }

@@ -43,8 +43,8 @@ static void *grow(void *p, uint64_t *cap, uint64_t need, size_t size) {
 }
 
 /* Which of the job's arrays a chunk frame fills (SC_CLIENT_TRIANGLES,
- * SC_CLIENT_NORMALS or SC_CLIENT_COMPONENTS), with the elements of it that
- * came before in *have; -1 after a protocol error. */
+ * SC_CLIENT_NORMALS, SC_CLIENT_VERTICES or SC_CLIENT_COMPONENTS), with the
+ * elements of it that came before in *have; -1 after a protocol error. */
 static int chunk_array(sc_client_t *c, sc_client_job_t *j, uint16_t type,
                        const scp_chunk_t *ch, uint64_t *have) {
   switch (type) {
@@ -64,6 +64,20 @@ static int chunk_array(sc_client_t *c, sc_client_job_t *j, uint16_t type,
       return -1;
     }
     return SC_CLIENT_NORMALS;
+  case SCP_VERTICES:
+    *have = j->nvertices;
+    /* The parser let only F64_XYZ through. */
+    if (!j->params.smoothed_vertices) {
+      scc_protocol_error(c, "VERTICES for job %u, which did not ask for them",
+                         j->id);
+      return -1;
+    }
+    if (ch->first + ch->count > j->n) {
+      scc_protocol_error(c, "job %u: more vertices than its %llu points", j->id,
+                         (unsigned long long)j->n);
+      return -1;
+    }
+    return SC_CLIENT_VERTICES;
   default:
     *have = j->ncomp;
     return SC_CLIENT_COMPONENTS;
@@ -77,8 +91,9 @@ static int chunk_array(sc_client_t *c, sc_client_job_t *j, uint16_t type,
 static void *chunk_dest(sc_client_job_t *j, int array, uint64_t have,
                         uint32_t count, void **scratch) {
   size_t esize = array == SC_CLIENT_TRIANGLES ? 3 * sizeof(uint32_t)
-                 : array == SC_CLIENT_NORMALS ? 3 * sizeof(double)
-                                              : sizeof(int32_t);
+                 : array == SC_CLIENT_NORMALS || array == SC_CLIENT_VERTICES
+                     ? 3 * sizeof(double)
+                     : sizeof(int32_t);
   *scratch = NULL;
   if (j->params.chunk)
     return *scratch = malloc((size_t)count * esize);
@@ -92,6 +107,11 @@ static void *chunk_dest(sc_client_job_t *j, int array, uint64_t have,
     if (!j->normals)
       j->normals = malloc((size_t)j->n * esize);
     return j->normals ? j->normals + 3 * have : NULL;
+  }
+  if (array == SC_CLIENT_VERTICES) {
+    if (!j->vertices)
+      j->vertices = malloc((size_t)j->n * esize);
+    return j->vertices ? j->vertices + 3 * have : NULL;
   }
   int32_t *g = grow(j->genus, &j->comp_cap, have + count, esize);
   if (g)
@@ -120,6 +140,9 @@ static int store_chunk(sc_client_t *c, sc_client_job_t *j, int array,
   } else if (array == SC_CLIENT_NORMALS) {
     scp_chunk_copy_xyz(ch, dst);
     j->nnormals += ch->count;
+  } else if (array == SC_CLIENT_VERTICES) {
+    scp_chunk_copy_xyz(ch, dst);
+    j->nvertices += ch->count;
   } else {
     int32_t *g = dst;
     scp_chunk_copy_i32(ch, g);
@@ -134,8 +157,8 @@ static int store_chunk(sc_client_t *c, sc_client_job_t *j, int array,
   return 0;
 }
 
-/* TRIANGLES, NORMALS and COMPONENTS: kept in the job, or handed to its
- * chunk callback. */
+/* TRIANGLES, NORMALS, VERTICES and COMPONENTS: kept in the job, or handed
+ * to its chunk callback. */
 static void on_chunk(sc_client_t *c, const scp_frame_t *f) {
   scp_chunk_t ch;
   int rc = scp_parse_chunk(f, &ch);
@@ -226,6 +249,20 @@ static void copy_values(const scp_values_t *in, sc_client_value_t **out,
   *count = k;
 }
 
+/* Whether the job got the VERTICES it should have (PROTOCOL.md 6.4):
+ * every point's when it asked and the daemon denoised it, none otherwise.
+ * JOB_DONE does not count them, so the diagnostic "denoised" says which;
+ * from a daemon that leaves it out, all or none will do. */
+static int vertices_ok(const sc_client_job_t *j, const scp_values_t *values) {
+  if (!j->params.smoothed_vertices)
+    return j->nvertices == 0;
+  scp_value_iter_t it;
+  scp_value_t v;
+  if (!scp_values_find(values, "denoised", &it, &v))
+    return j->nvertices == 0 || j->nvertices == j->n;
+  return j->nvertices == (v.kind == SCP_KIND_U64 && v.v.u == 1 ? j->n : 0);
+}
+
 static void on_job_done(sc_client_t *c, const scp_frame_t *f) {
   scp_job_done_t m;
   int rc = scp_parse_job_done(f, &m);
@@ -267,6 +304,14 @@ static void on_job_done(sc_client_t *c, const scp_frame_t *f) {
         j->id, (unsigned long long)m.triangles, (unsigned long long)m.normals,
         (unsigned long long)m.components, (unsigned long long)j->ntri,
         (unsigned long long)j->nnormals, (unsigned long long)j->ncomp);
+    return;
+  }
+  if (!vertices_ok(j, &m.values)) {
+    scc_protocol_error(c,
+                       "job %u ended with %llu smoothed vertices for its "
+                       "%llu points",
+                       j->id, (unsigned long long)j->nvertices,
+                       (unsigned long long)j->n);
     return;
   }
   copy_values(&m.values, &j->values, &j->nvalues);
@@ -398,6 +443,7 @@ void scc_dispatch(sc_client_t *c, const scp_frame_t *f) {
   }
   case SCP_TRIANGLES:
   case SCP_NORMALS:
+  case SCP_VERTICES:
   case SCP_COMPONENTS:
     on_chunk(c, f);
     return;
@@ -485,6 +531,8 @@ int sc_client_job_mesh(const sc_client_job_t *job, sc_client_mesh_t *out) {
   out->triangle_count = job->ntri;
   out->normals = job->normals;
   out->normal_count = job->nnormals;
+  out->vertices = job->vertices;
+  out->vertex_count = job->nvertices;
   out->genus = job->genus;
   out->component_count = job->ncomp;
   out->values = job->values;

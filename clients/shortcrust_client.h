@@ -202,6 +202,7 @@ typedef int (*sc_client_progress_fn)(void *user, sc_client_job_t *job,
 #define SC_CLIENT_TRIANGLES 1  /* data: 3 * count uint32_t */
 #define SC_CLIENT_NORMALS 2    /* data: 3 * count double */
 #define SC_CLIENT_COMPONENTS 3 /* data: count int32_t, genus or -1 */
+#define SC_CLIENT_VERTICES 4   /* data: 3 * count double, smoothed points */
 
 /*
  * A chunk of the mesh as it arrives: elements first .. first + count - 1 of
@@ -228,7 +229,8 @@ typedef struct sc_client_params {
    * parameter table (SC_PARAM_MAP in shortcrust.h) that travels as an
    * option, with that row's name, type, range and meaning, in its order:
    * today paper_pruning, max_hole_edges, boundary_rho (in (0, 10]),
-   * boundary_alpha (in (0, pi/2] radians) and watertight_labels. Each is
+   * boundary_alpha (in (0, pi/2] radians), watertight_labels, denoise,
+   * denoise_scale and smoothed_vertices (the mesh's vertices, below). Each is
    * sent only when not left at its "daemon's default" value, which
    * sc_client_params_init() sets: -1 for an integer, 0 for a number or a
    * flag. A daemon that does not take job options gets no job: it ends
@@ -329,6 +331,13 @@ typedef struct sc_client_mesh {
   uint64_t triangle_count;
   const double *normals; /* 3 * normal_count, when asked for */
   uint64_t normal_count;
+  /* With smoothed_vertices, when the daemon denoised the job (its value
+   * "denoised" is 1): the smoothed position of every point, 3 *
+   * vertex_count doubles (vertex_count = point_count), to use as the
+   * mesh's vertices (NULL, as the triangles, when a chunk callback took
+   * them); otherwise NULL and 0. */
+  const double *vertices;
+  uint64_t vertex_count;
   const int32_t *genus; /* per component, -1 for one with boundary */
   uint64_t component_count;
   /* The daemon's diagnostics (PROTOCOL.md section 6.12). */

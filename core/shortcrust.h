@@ -226,7 +226,7 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "denoise-scale", "S",                                                      \
     "denoising: radius of the smoothing neighbourhood, in the input's units " \
     "(default: estimated); given, it smooths whatever the noise")             \
-  X(smoothed_vertices, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", LOCAL,   \
+  X(smoothed_vertices, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION,  \
     0, "smoothed-vertices", NULL,                                              \
     "denoising: give the mesh the smoothed positions of the samples instead "  \
     "of the original ones")

@@ -17,9 +17,9 @@
 /* Sending meshes. */
 
 static uint64_t mesh_bytes(const sc_mesh_t *m) {
-  return sizeof *m + m->triangle_count * 3 * sizeof(uint32_t) +
-         m->point_count * 3 * sizeof(double) +
-         m->component_count * sizeof(int32_t);
+  uint64_t xyz = m->point_count * 3 * sizeof(double);
+  return sizeof *m + m->triangle_count * 3 * sizeof(uint32_t) + xyz +
+         (m->smoothed ? xyz : 0) + m->component_count * sizeof(int32_t);
 }
 
 /* The diagnostics of the core's table, as JOB_DONE values (PROTOCOL.md
@@ -109,6 +109,13 @@ void scd_conn_pump(scd_conn_t *c) {
       view.normal_count = m->point_count;
       view.normal_format =
           (j->flags & SCP_JOB_NORMALS_F64) ? SCP_F64_XYZ : SCP_F32_XYZ;
+    }
+    /* The core keeps the smoothed positions only when the job asked for
+     * them (the smoothed_vertices option) and was denoised: exactly when
+     * PROTOCOL.md 6.4 sends VERTICES. */
+    if (m->smoothed) {
+      view.vertices = m->smoothed;
+      view.vertex_count = m->point_count;
     }
     view.genus = m->component_genus;
     view.component_count = m->component_count;

@@ -12,7 +12,8 @@
  * Nothing is ever allocated on the strength of a length field: the buffer
  * grows only with the bytes the caller feeds, and a header whose length is
  * over the limit is refused as soon as its eight bytes are in. Ignorable
- * frames are discarded as their bytes arrive and never buffered whole.
+ * frames that are not for this reader are discarded as their bytes arrive
+ * and never buffered whole.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -151,6 +152,22 @@ int scp_decoder_feed(scp_decoder_t *d, const void *bytes, size_t len) {
   return 0;
 }
 
+/* Is this an ignorable frame to drop unread? PROTOCOL.md 3.2 treats a type
+ * that travels the wrong way like an unknown one, so a server skips
+ * VERTICES just as it skips a type it has never heard of. */
+static int skipped_type(const scp_decoder_t *d, uint16_t type) {
+  if (!(type & SCP_TYPE_IGNORABLE))
+    return 0;
+  int senders = scp_type_senders(type);
+  switch (d->role) {
+  case SCP_ROLE_SERVER:
+    return !(senders & SCP_FROM_CLIENT);
+  case SCP_ROLE_CLIENT:
+    return !(senders & SCP_FROM_SERVER);
+  }
+  return senders == 0;
+}
+
 /* Is a frame of this type allowed at this point of the stream? */
 static int position_ok(const scp_decoder_t *d, uint16_t type) {
   int handshake = type == SCP_HELLO || type == SCP_WELCOME;
@@ -189,7 +206,7 @@ int scp_decoder_next(scp_decoder_t *d, scp_frame_t *frame) {
      * around when the header is added. */
     if ((uint64_t)length + SCP_HEADER_SIZE > d->max_frame)
       return fail(d, SCP_ETOOBIG);
-    if ((type & SCP_TYPE_IGNORABLE) && scp_type_senders(type) == 0) {
+    if (skipped_type(d, type)) {
       d->skip = (uint64_t)length + SCP_HEADER_SIZE;
       d->counters.skipped++;
       continue;

@@ -402,6 +402,11 @@ int scp_enc_normals(scp_buf_t *b, uint32_t job_id, uint64_t first,
   return enc_xyz(b, SCP_NORMALS, job_id, first, format, xyz, count);
 }
 
+int scp_enc_vertices(scp_buf_t *b, uint32_t job_id, uint64_t first,
+                     const double *xyz, uint32_t count) {
+  return enc_xyz(b, SCP_VERTICES, job_id, first, SCP_F64_XYZ, xyz, count);
+}
+
 int scp_enc_points_f32(scp_buf_t *b, uint32_t job_id, uint64_t first,
                        const float *xyz, uint32_t count) {
   uint8_t *p;
@@ -500,6 +505,16 @@ int scp_enc_mesh_next(scp_buf_t *b, const scp_mesh_view_t *m,
     c->normals += k;
     return 1;
   }
+  if (m->vertices && c->vertices < m->vertex_count) {
+    k = next_count(b, SCP_F64_XYZ, m->vertex_count, c->vertices);
+    rc = k ? scp_enc_vertices(b, m->job_id, c->vertices,
+                              m->vertices + 3 * c->vertices, k)
+           : SCP_ETOOBIG;
+    if (rc)
+      return rc;
+    c->vertices += k;
+    return 1;
+  }
   if (c->components < m->component_count) {
     k = next_count(b, SCP_I32, m->component_count, c->components);
     rc = k ? scp_enc_components(b, m->job_id, c->components,
@@ -573,6 +588,7 @@ int scp_enc_msg(scp_buf_t *b, const scp_msg_t *m) {
   case SCP_POINTS:
   case SCP_TRIANGLES:
   case SCP_NORMALS:
+  case SCP_VERTICES:
   case SCP_COMPONENTS:
     if (m->u.chunk.type != m->type)
       return SCP_EINVAL;

@@ -99,6 +99,7 @@ int scp_type_senders(uint16_t type) {
   case SCP_PROGRESS:
   case SCP_TRIANGLES:
   case SCP_NORMALS:
+  case SCP_VERTICES:
   case SCP_COMPONENTS:
   case SCP_JOB_DONE:
   case SCP_JOB_ERROR:
@@ -138,6 +139,8 @@ const char *scp_type_name(uint16_t type) {
     return "TRIANGLES";
   case SCP_NORMALS:
     return "NORMALS";
+  case SCP_VERTICES:
+    return "VERTICES";
   case SCP_COMPONENTS:
     return "COMPONENTS";
   case SCP_JOB_DONE:
@@ -187,6 +190,9 @@ int scp__chunk_format_ok(uint16_t type, uint32_t format) {
   case SCP_POINTS:
   case SCP_NORMALS:
     return format == SCP_F32_XYZ || format == SCP_F64_XYZ;
+  case SCP_VERTICES:
+    /* Positions for the client to write as they are: never rounded. */
+    return format == SCP_F64_XYZ;
   case SCP_TRIANGLES:
     return format == SCP_U32_TRIANGLE;
   case SCP_COMPONENTS:

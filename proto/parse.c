@@ -216,7 +216,7 @@ int scp_parse_progress(const scp_frame_t *f, scp_progress_t *out) {
 
 static int is_chunk_type(uint16_t type) {
   return type == SCP_POINTS || type == SCP_TRIANGLES || type == SCP_NORMALS ||
-         type == SCP_COMPONENTS;
+         type == SCP_VERTICES || type == SCP_COMPONENTS;
 }
 
 int scp_parse_chunk(const scp_frame_t *f, scp_chunk_t *out) {
@@ -341,6 +341,7 @@ int scp_parse(const scp_frame_t *f, scp_msg_t *out) {
   case SCP_POINTS:
   case SCP_TRIANGLES:
   case SCP_NORMALS:
+  case SCP_VERTICES:
   case SCP_COMPONENTS:
     return scp_parse_chunk(f, &out->u.chunk);
   case SCP_JOB_END:
@@ -382,6 +383,7 @@ int scp_frame_job_id(const scp_frame_t *f, uint32_t *job_id) {
   case SCP_PROGRESS:
   case SCP_TRIANGLES:
   case SCP_NORMALS:
+  case SCP_VERTICES:
   case SCP_COMPONENTS:
   case SCP_JOB_DONE:
   case SCP_JOB_ERROR:

@@ -64,7 +64,8 @@ extern "C" {
 #define SCP_MESSAGE_MAX 1024
 /* Longest name in a value list, in bytes. */
 #define SCP_NAME_MAX 63
-/* Fixed part of every chunk frame (POINTS, TRIANGLES, NORMALS, COMPONENTS). */
+/* Fixed part of every chunk frame (POINTS, TRIANGLES, NORMALS, VERTICES,
+ * COMPONENTS). */
 #define SCP_CHUNK_HEADER 24
 /* Fixed part of JOB_BEGIN; job options follow it, where the JOB_OPTIONS
  * feature is in force, from byte SCP_JOB_BEGIN_FIXED + 8 on. */
@@ -165,11 +166,15 @@ typedef enum scp_type {
   SCP_COMPONENTS = 0x0024,
   SCP_JOB_DONE = 0x0025,
   SCP_JOB_ERROR = 0x0026,
-  SCP_STATS = 0x0027
+  SCP_STATS = 0x0027,
+  /* Ignorable (below): a client that does not know it, or did not ask for
+   * the smoothed positions, loses nothing by skipping it. */
+  SCP_VERTICES = 0x8001
 } scp_type_t;
 
 /* Types with this bit are skipped silently by a receiver that does not know
- * them; other unknown types earn an ERROR UNKNOWN_TYPE. */
+ * them, or that is not the side they go to; other unknown types earn an
+ * ERROR UNKNOWN_TYPE. */
 #define SCP_TYPE_IGNORABLE 0x8000u
 
 /* Who may send a type: a mask of these, or 0 for a type version 1 lacks. */
@@ -319,8 +324,8 @@ typedef struct scp_progress {
  * load them byte by byte, so the payload needs no particular alignment.
  */
 typedef struct scp_chunk {
-  uint16_t type;        /* SCP_POINTS, SCP_TRIANGLES, SCP_NORMALS or
-                           SCP_COMPONENTS */
+  uint16_t type;        /* SCP_POINTS, SCP_TRIANGLES, SCP_NORMALS,
+                           SCP_VERTICES or SCP_COMPONENTS */
   uint32_t job_id;      /* != 0 */
   uint32_t count;       /* >= 1 */
   uint64_t first;       /* first + count does not overflow */
@@ -445,13 +450,15 @@ int scp_enc_stats(scp_buf_t *b, uint32_t tag, const scp_value_t *values,
 
 /* One chunk frame of exactly count elements (which must fit in
  * b->max_frame). POINTS and NORMALS take format SCP_F32_XYZ (the doubles
- * are rounded to float) or SCP_F64_XYZ. */
+ * are rounded to float) or SCP_F64_XYZ; VERTICES are always SCP_F64_XYZ. */
 int scp_enc_points(scp_buf_t *b, uint32_t job_id, uint64_t first,
                    uint32_t format, const double *xyz, uint32_t count);
 int scp_enc_points_f32(scp_buf_t *b, uint32_t job_id, uint64_t first,
                        const float *xyz, uint32_t count);
 int scp_enc_normals(scp_buf_t *b, uint32_t job_id, uint64_t first,
                     uint32_t format, const double *xyz, uint32_t count);
+int scp_enc_vertices(scp_buf_t *b, uint32_t job_id, uint64_t first,
+                     const double *xyz, uint32_t count);
 int scp_enc_triangles(scp_buf_t *b, uint32_t job_id, uint64_t first,
                       const uint32_t *tri, uint32_t count);
 int scp_enc_components(scp_buf_t *b, uint32_t job_id, uint64_t first,
@@ -478,8 +485,9 @@ uint32_t scp_chunk_capacity(uint32_t format, uint32_t max_frame);
 int scp_enc_points_next(scp_buf_t *b, uint32_t job_id, uint32_t format,
                         const double *xyz, uint64_t total, uint64_t *next);
 
-/* A finished mesh as the server holds it. normals may be NULL (then
- * normal_count is ignored); genus may be NULL when component_count is 0. */
+/* A finished mesh as the server holds it. normals and vertices may be NULL
+ * (then their counts are ignored); genus may be NULL when component_count
+ * is 0. */
 typedef struct scp_mesh_view {
   uint32_t job_id;
   const uint32_t *triangles;   /* 3 * triangle_count */
@@ -487,6 +495,8 @@ typedef struct scp_mesh_view {
   const double *normals;       /* 3 * normal_count */
   uint64_t normal_count;
   uint32_t normal_format;      /* SCP_F32_XYZ or SCP_F64_XYZ */
+  const double *vertices;      /* 3 * vertex_count, sent as SCP_F64_XYZ */
+  uint64_t vertex_count;
   const int32_t *genus;        /* component_count */
   uint64_t component_count;
 } scp_mesh_view_t;
@@ -495,12 +505,13 @@ typedef struct scp_mesh_view {
 typedef struct scp_mesh_cursor {
   uint64_t triangles;
   uint64_t normals;
+  uint64_t vertices;
   uint64_t components;
 } scp_mesh_cursor_t;
 
 /* Appends the mesh's next chunk: all TRIANGLES first, then NORMALS, then
- * COMPONENTS. Returns 1 when it appended a frame, 0 when the mesh is all
- * sent (JOB_DONE is the caller's to send), or a negative code. */
+ * VERTICES, then COMPONENTS. Returns 1 when it appended a frame, 0 when the
+ * mesh is all sent (JOB_DONE is the caller's to send), or a negative code. */
 int scp_enc_mesh_next(scp_buf_t *b, const scp_mesh_view_t *m,
                       scp_mesh_cursor_t *c);
 
@@ -546,9 +557,10 @@ void scp_limits_init(scp_limits_t *l);
  * checked as soon as its first four payload bytes are in (SCP_EBADMAGIC).
  * The payload itself is not parsed here; that is scp_parse_*()'s job.
  *
- * Frames of an ignorable type this version does not know (type 0x8000 and
- * above) are skipped silently, as PROTOCOL.md 3.2 requires: their bytes are
- * dropped as they arrive, and they are only counted. Every other frame,
+ * Frames of an ignorable type (0x8000 and above) that this version does
+ * not know, or that the other side of the role sends (VERTICES to a
+ * server), are skipped silently, as PROTOCOL.md 3.2 requires: their bytes
+ * are dropped as they arrive, and they are only counted. Every other frame,
  * including unknown types without the high bit, is returned.
  *
  * Nothing is allocated on the word of a length field. The decoder copies
@@ -594,7 +606,7 @@ uint32_t scp_decoder_max_frame(const scp_decoder_t *d);
 typedef struct scp_decoder_counters {
   uint64_t bytes;   /* bytes fed */
   uint64_t frames;  /* frames returned by scp_decoder_next() */
-  uint64_t skipped; /* ignorable frames of unknown types, dropped */
+  uint64_t skipped; /* ignorable frames not for this role, dropped */
   uint64_t buffer;  /* bytes allocated for the buffer now */
 } scp_decoder_counters_t;
 void scp_decoder_get_counters(const scp_decoder_t *d,
@@ -626,7 +638,7 @@ int scp_parse_progress(const scp_frame_t *f, scp_progress_t *out);
 int scp_parse_job_done(const scp_frame_t *f, scp_job_done_t *out);
 int scp_parse_job_error(const scp_frame_t *f, scp_job_error_t *out);
 int scp_parse_stats(const scp_frame_t *f, scp_stats_t *out);
-/* Any of the four chunk types. */
+/* Any of the five chunk types. */
 int scp_parse_chunk(const scp_frame_t *f, scp_chunk_t *out);
 
 /* Any message, dispatched on the type; SCP_EUNKNOWN_TYPE for a type this
@@ -644,7 +656,7 @@ typedef struct scp_msg {
     uint32_t tag;          /* STATS_REQUEST */
     scp_accepted_t accepted;
     scp_progress_t progress;
-    scp_chunk_t chunk;     /* POINTS, TRIANGLES, NORMALS, COMPONENTS */
+    scp_chunk_t chunk;     /* the five chunk types */
     scp_job_done_t job_done;
     scp_job_error_t job_error;
     scp_stats_t stats;
@@ -663,9 +675,9 @@ int scp_parse_as(const scp_frame_t *f, int role, scp_msg_t *out);
 int scp_enc_msg(scp_buf_t *b, const scp_msg_t *m);
 
 /* For a job frame (JOB_BEGIN, POINTS, JOB_END, CANCEL, ACCEPTED, PROGRESS,
- * TRIANGLES, NORMALS, COMPONENTS, JOB_DONE, JOB_ERROR) whose payload holds
- * at least the job id, stores the id and returns 1, whether or not the rest
- * parses; returns 0 for other frames. */
+ * TRIANGLES, NORMALS, VERTICES, COMPONENTS, JOB_DONE, JOB_ERROR) whose
+ * payload holds at least the job id, stores the id and returns 1, whether or
+ * not the rest parses; returns 0 for other frames. */
 int scp_frame_job_id(const scp_frame_t *f, uint32_t *job_id);
 
 /*

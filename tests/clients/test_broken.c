@@ -4,8 +4,9 @@
  * A version mismatch (by ERROR and by WELCOME), a peer that speaks another
  * protocol, a silent one; a daemon that breaks the protocol in the middle
  * of a job (an index out of range, a chunk out of order, totals that
- * disagree, a frame for a job not in use), each costing the connection
- * with a fatal ERROR PROTOCOL sent back; a daemon that closes mid-job; and
+ * disagree, a frame for a job not in use, smoothed vertices a job did not
+ * ask for or too few of them), each costing the connection with a fatal
+ * ERROR PROTOCOL sent back; a daemon that closes mid-job; and
  * the parts of the protocol a client must handle that the daemon does not
  * use (PING from the server, unknown frame types); and a daemon without
  * job options, to which a job that has some is never sent.
@@ -40,8 +41,16 @@ enum {
   S_UNKNOWN_JOB,   /* ACCEPTED for a job id not in use */
   S_CLOSE_MID_JOB, /* closes after ACCEPTED */
   S_GOOD,          /* PING, unknown types, then the mesh */
-  S_NO_OPTIONS     /* WELCOME without JOB_OPTIONS, then reads to the end */
+  S_NO_OPTIONS,    /* WELCOME without JOB_OPTIONS, then reads to the end */
+  S_VERT_UNASKED,  /* VERTICES for a job without smoothed_vertices */
+  S_VERT_SHORT,    /* 3 VERTICES for 4 points of a job denoised */
+  S_VERT           /* the mesh over 4 VERTICES, as asked */
 };
+
+/* The scripts whose job asks for smoothed vertices (and denoise). */
+static int asks_vertices(int script) {
+  return script == S_VERT_SHORT || script == S_VERT;
+}
 
 typedef struct fake {
   char dir[128], sock[160];
@@ -118,7 +127,8 @@ static int read_until(fake_t *f, uint16_t type, scp_frame_t *fr) {
 
 static void welcome(fake_t *f, scp_buf_t *b) {
   scp_welcome_t w = {.version = 1,
-                     .features = 0,
+                     .features =
+                         asks_vertices(f->script) ? SCP_FEATURE_JOB_OPTIONS : 0,
                      .max_frame = 4096,
                      .max_jobs = 4,
                      .max_points = 1000};
@@ -204,14 +214,18 @@ static void run_script(fake_t *f) {
     if (f->script == S_BAD_ORDER)
       first = 1;
     scp_enc_triangles(&b, 1, first, tri, 4);
+    if (f->script == S_VERT_UNASKED || asks_vertices(f->script))
+      scp_enc_vertices(&b, 1, 0, tetra, f->script == S_VERT_SHORT ? 3 : 4);
     int32_t genus = 0;
     scp_enc_components(&b, 1, 0, &genus, 1);
-    scp_value_t v = {.name = "triangles", .kind = SCP_KIND_U64, .v.u = 4};
+    /* JOB_DONE does not count the vertices; "denoised" says how many. */
+    scp_value_t v[2] = {{.name = "triangles", .kind = SCP_KIND_U64, .v.u = 4},
+                        {.name = "denoised", .kind = SCP_KIND_U64, .v.u = 1}};
     scp_job_done_t done = {
         .job_id = 1, .triangles = 4, .normals = 0, .components = 1};
     if (f->script == S_BAD_TOTALS)
       done.triangles = 5;
-    scp_enc_job_done(&b, &done, &v, 1);
+    scp_enc_job_done(&b, &done, v, asks_vertices(f->script) ? 2 : 1);
     send_buf(f, &b);
     /* What the client says to that: a fatal ERROR, or for the good
      * script the answers to PING and to the unknown type, then its
@@ -314,8 +328,11 @@ static int job_against(int script, fake_t *f, char *msg, size_t len) {
     fake_finish(f);
     return rc;
   }
+  sc_client_params_t p;
+  sc_client_params_init(&p);
+  p.denoise = p.smoothed_vertices = asks_vertices(script);
   sc_client_job_t *j = NULL;
-  rc = sc_client_submit(c, NULL, tetra, 4, &j);
+  rc = sc_client_submit(c, &p, tetra, 4, &j);
   EXPECT_MSG(rc == 0, "submit: %s", sc_client_last_error(c));
   if (rc == 0) {
     rc = sc_client_wait(c, j, 10000);
@@ -331,6 +348,13 @@ static int job_against(int script, fake_t *f, char *msg, size_t len) {
                  "components");
       /* The PING's answer must go out; a PING of ours flushes it. */
       sc_client_ping(c, 100, NULL);
+    }
+    if (script == S_VERT && rc == 0) {
+      sc_client_mesh_t m;
+      sc_client_job_mesh(j, &m);
+      EXPECT_EQ(m.vertex_count, 4);
+      EXPECT_MSG(m.vertices && memcmp(m.vertices, tetra, sizeof tetra) == 0,
+                 "vertices differ");
     }
   }
   sc_client_job_free(j);
@@ -352,6 +376,9 @@ static void broken_jobs(void) {
       {S_BAD_TOTALS, SC_CLIENT_EPROTOCOL, "counts 5 triangles"},
       {S_UNKNOWN_JOB, SC_CLIENT_EPROTOCOL, "ACCEPTED for job 99"},
       {S_CLOSE_MID_JOB, SC_CLIENT_ELOST, "closed the connection"},
+      {S_VERT_UNASKED, SC_CLIENT_EPROTOCOL, "did not ask for them"},
+      {S_VERT_SHORT, SC_CLIENT_EPROTOCOL,
+       "3 smoothed vertices for its 4 points"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     int rc = job_against(cases[i].script, &f, msg, sizeof msg);
@@ -367,6 +394,9 @@ static void broken_jobs(void) {
   EXPECT_MSG(f.got_pong, "no PONG for the server's PING");
   EXPECT_MSG(f.got_unknown_type_error, "no ERROR UNKNOWN_TYPE for type 0x0040");
   EXPECT_MSG(!f.got_fatal_protocol, "a fatal ERROR for a good stream");
+  rc = job_against(S_VERT, &f, msg, sizeof msg);
+  EXPECT_MSG(rc == 0, "smoothed vertices: %s: %s", sc_client_err_name(rc), msg);
+  EXPECT_MSG(!f.got_fatal_protocol, "a fatal ERROR for smoothed vertices");
 }
 
 /* A job with options against a daemon that does not take them: refused

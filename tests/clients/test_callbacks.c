@@ -1,8 +1,9 @@
 /*
  * The client library's callbacks: progress through upload, the daemon's
  * stages and download; the mesh chunk by chunk as it arrives, in order and
- * identical to the mesh collected into a buffer; and a callback that calls
- * back into its own handle, which the library refuses.
+ * identical to the mesh collected into a buffer, smoothed vertices too; and
+ * a callback that calls back into its own handle, which the library
+ * refuses.
  *
  *   test_clients_callbacks DAEMON
  *
@@ -59,6 +60,8 @@ typedef struct collected {
   uint64_t ntri;
   double *normals;
   uint64_t nnormals;
+  double *vertices;
+  uint64_t nvertices;
   int32_t *genus;
   uint64_t ncomp;
   unsigned chunks;
@@ -85,6 +88,14 @@ static int on_chunk(void *user, sc_client_job_t *job, int array, uint64_t first,
         realloc(k->normals, (size_t)(first + count) * 3 * sizeof(double));
     memcpy(k->normals + 3 * first, data, (size_t)count * 3 * sizeof(double));
     k->nnormals = first + count;
+    break;
+  case SC_CLIENT_VERTICES:
+    if (first != k->nvertices || first + count > k->n)
+      k->bad = 1;
+    k->vertices =
+        realloc(k->vertices, (size_t)(first + count) * 3 * sizeof(double));
+    memcpy(k->vertices + 3 * first, data, (size_t)count * 3 * sizeof(double));
+    k->nvertices = first + count;
     break;
   case SC_CLIENT_COMPONENTS:
     if (first != k->ncomp)
@@ -197,12 +208,60 @@ static void chunks(void) {
   free(xyz);
 }
 
+/* Smoothed vertices (a given scale smooths even a clean sphere) come to
+ * the chunk callback as they are kept in a buffer, one per point, and are
+ * not the points sent. */
+static void vertices(void) {
+  const uint64_t n = 5000;
+  double *xyz = scdt_sample(SCS_SURF_SPHERE, n, 7);
+  sc_client_t *c = scct_open(d.sock, 4096);
+  sc_client_params_t p;
+  sc_client_params_init(&p);
+  p.denoise = 1;
+  p.denoise_scale = 0.1;
+  p.smoothed_vertices = 1;
+  sc_client_job_t *whole, *parts;
+  ASSERT_MSG(sc_client_submit(c, &p, xyz, n, &whole) == 0, "submit: %s",
+             sc_client_last_error(c));
+  collected_t k;
+  memset(&k, 0, sizeof k);
+  k.n = n;
+  p.chunk = on_chunk;
+  p.chunk_user = &k;
+  ASSERT_MSG(sc_client_submit(c, &p, xyz, n, &parts) == 0, "submit: %s",
+             sc_client_last_error(c));
+  EXPECT_EQ(sc_client_wait(c, whole, SCCT_WAIT_MS), 0);
+  EXPECT_EQ(sc_client_wait(c, parts, SCCT_WAIT_MS), 0);
+  sc_client_mesh_t a, b;
+  EXPECT_EQ(sc_client_job_mesh(whole, &a), 0);
+  EXPECT_EQ(sc_client_job_mesh(parts, &b), 0);
+  EXPECT_EQ(sc_client_value_get(a.values, a.value_count, "denoised", 0), 1);
+  EXPECT_MSG(!k.bad, "a chunk came out of order");
+  EXPECT_EQ(a.vertex_count, n);
+  EXPECT_EQ(k.nvertices, n);
+  EXPECT_MSG(b.vertices == NULL && b.vertex_count == n,
+             "a job with a chunk callback kept its vertices");
+  EXPECT_MSG(a.vertices && k.vertices &&
+                 memcmp(a.vertices, k.vertices, 3 * n * sizeof(double)) == 0,
+             "the vertices differ between the two jobs");
+  EXPECT_MSG(a.vertices && memcmp(a.vertices, xyz, 3 * n * sizeof(double)),
+             "the vertices are the points sent");
+  free(k.tri);
+  free(k.vertices);
+  free(k.genus);
+  sc_client_job_free(whole);
+  sc_client_job_free(parts);
+  sc_client_free(c);
+  free(xyz);
+}
+
 int main(int argc, char **argv) {
   scdt_init(argc, argv);
   const char *args[] = {"--workers", "2", NULL};
   ASSERT_MSG(scdt_daemon_start(&d, args) == 0, "daemon did not start");
   progress();
   chunks();
+  vertices();
   EXPECT_EQ(scdt_daemon_stop(&d), 0);
   return scdt_finish();
 }

@@ -21,6 +21,7 @@ start_daemon "$scd" "$sc" --workers 2
 
 expect 0 "usage: shortcrust submit" "$sc" submit --help
 for opt in --output --mode --r --theta --max-hole --paper-pruning --labels --rho --alpha \
+           --denoise --denoise-scale --smoothed-vertices \
            --socket --report --ascii --no-normals --quiet; do
   grep -q -- "$opt" "$tmp/out" || fail "submit --help does not mention $opt"
 done
@@ -44,7 +45,10 @@ for in in knot1_points kitten_points noisy; do
          --mode_watertight_--labels_--paper-pruning --mode_cocone_--denoise"
   if [ "$in" = noisy ]; then
     file=$data_noisy
-    modes="--mode_watertight_--denoise --mode_auto --mode_cocone_--denoise_--denoise-scale_0.04"
+    # --smoothed-vertices: the daemon sends the positions it smoothed, and
+    # none where it did not smooth (no --denoise).
+    modes="--mode_watertight_--denoise --mode_auto --mode_cocone_--denoise_--denoise-scale_0.04
+           --mode_watertight_--denoise_--smoothed-vertices --mode_cocone_--smoothed-vertices"
   fi
   for mode in $modes; do
     mode=$(echo "$mode" | tr _ ' ')
@@ -68,6 +72,21 @@ for in in knot1_points kitten_points noisy; do
     grep -q '"transfer": ' "$tmp/a/r.json" || fail "report lacks the transfer time"
   done
 done
+
+# The smoothed positions are written, not the points of the file: the
+# first vertex differs from the one written without --smoothed-vertices,
+# while the triangles and the local command's file are the same.
+expect 0 "" "$sc" submit "$data_noisy" -o "$tmp/s1.ply" --socket "$sock" --denoise --ascii
+expect 0 "" "$sc" submit "$data_noisy" -o "$tmp/s2.ply" --socket "$sock" --denoise --ascii \
+  --smoothed-vertices
+expect 0 "" "$sc" reconstruct "$data_noisy" -o "$tmp/s3.ply" --denoise --ascii --smoothed-vertices
+cmp -s "$tmp/s2.ply" "$tmp/s3.ply" || fail "submit --smoothed-vertices differs from reconstruct's"
+sed -n '/end_header/,$p' "$tmp/s1.ply" | sed -n 2p > "$tmp/v1"
+sed -n '/end_header/,$p' "$tmp/s2.ply" | sed -n 2p > "$tmp/v2"
+[ -s "$tmp/v1" ] || fail "no vertex in $tmp/s1.ply"
+cmp -s "$tmp/v1" "$tmp/v2" && fail "submit --smoothed-vertices wrote the original positions"
+tail -n 100 "$tmp/s1.ply" > "$tmp/f1"; tail -n 100 "$tmp/s2.ply" > "$tmp/f2"
+cmp -s "$tmp/f1" "$tmp/f2" || fail "submit --smoothed-vertices changed the triangles"
 
 # Every output format, and the closed genus-1 knot in each.
 for out in k.obj k.off k.stl; do

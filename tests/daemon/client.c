@@ -273,6 +273,7 @@ void scdt_job_init(scdt_job_t *j, uint32_t id, const double *xyz,
 void scdt_job_reset(scdt_job_t *j) {
   free(j->tri);
   free(j->normals);
+  free(j->vertices);
   free(j->genus);
   scdt_job_t keep = *j;
   scdt_job_init(j, keep.id, keep.xyz, keep.n);
@@ -363,9 +364,10 @@ static int grow(void **p, uint64_t count, size_t size) {
 /* One chunk for job j, checked and appended. */
 static int take_chunk(scdt_job_t *j, const scp_chunk_t *ch, char *why,
                       size_t len) {
-  uint64_t have = ch->type == SCP_TRIANGLES ? j->ntri
-                  : ch->type == SCP_NORMALS ? j->nnormals
-                                            : j->ncomp;
+  uint64_t have = ch->type == SCP_TRIANGLES  ? j->ntri
+                  : ch->type == SCP_NORMALS  ? j->nnormals
+                  : ch->type == SCP_VERTICES ? j->nvertices
+                                             : j->ncomp;
   if (ch->first != have)
     return fail(why, len, "job %u: %s chunk at %llu, expected %llu", j->id,
                 scp_type_name(ch->type), (unsigned long long)ch->first,
@@ -394,6 +396,14 @@ static int take_chunk(scdt_job_t *j, const scp_chunk_t *ch, char *why,
       return fail(why, len, "out of memory");
     scp_chunk_copy_xyz(ch, j->normals + 3 * have);
     j->nnormals = total;
+    break;
+  case SCP_VERTICES:
+    if (total > j->n)
+      return fail(why, len, "job %u: more vertices than points", j->id);
+    if (grow((void **)&j->vertices, 3 * total, sizeof(double)))
+      return fail(why, len, "out of memory");
+    scp_chunk_copy_xyz(ch, j->vertices + 3 * have);
+    j->nvertices = total;
     break;
   case SCP_COMPONENTS:
     if (grow((void **)&j->genus, total, sizeof(int32_t)))
@@ -451,6 +461,7 @@ static int collect_one(scdt_conn_t *c, scdt_job_t **jobs, size_t njobs,
     return 0;
   case SCP_TRIANGLES:
   case SCP_NORMALS:
+  case SCP_VERTICES:
   case SCP_COMPONENTS:
     return take_chunk(j, &m.u.chunk, why, len);
   case SCP_JOB_DONE: {
@@ -468,6 +479,10 @@ static int collect_one(scdt_conn_t *c, scdt_job_t **jobs, size_t njobs,
     if ((j->flags & SCP_JOB_NORMALS) && j->nnormals != j->n)
       return fail(why, len, "job %u: %llu normals for %llu points", id,
                   (unsigned long long)j->nnormals, (unsigned long long)j->n);
+    /* JOB_DONE does not count them (PROTOCOL.md 6.4): all or none. */
+    if (j->nvertices != 0 && j->nvertices != j->n)
+      return fail(why, len, "job %u: %llu vertices for %llu points", id,
+                  (unsigned long long)j->nvertices, (unsigned long long)j->n);
     scp_value_iter_t it;
     scp_value_t v;
     if (scp_values_find(&d->values, "triangles", &it, &v))

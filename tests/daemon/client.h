@@ -89,6 +89,8 @@ typedef struct scdt_job {
   uint64_t ntri;
   double *normals;
   uint64_t nnormals;
+  double *vertices; /* VERTICES: the smoothed positions */
+  uint64_t nvertices;
   int32_t *genus;
   uint64_t ncomp;
   unsigned progress;   /* PROGRESS frames */

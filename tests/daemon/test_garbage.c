@@ -194,6 +194,16 @@ static void invalid_requests(void) {
   EXPECT_MSG(f && f->type == SCP_PONG, "ignorable type: want PONG, got %s",
              f ? scp_type_name(f->type) : "nothing");
   free(f);
+  /* So is an ignorable type only servers send (PROTOCOL.md 3.2). */
+  double xyz[3] = {1, 2, 3};
+  scp_enc_vertices(&b, 1, 0, xyz, 1);
+  scp_enc_ping(&b, 6);
+  EXPECT_MSG(scdt_send_raw(c, b.data, b.len, T_MS) == 0, "send");
+  b.len = 0;
+  f = scdt_recv(c, T_MS);
+  EXPECT_MSG(f && f->type == SCP_PONG, "client's VERTICES: want PONG, got %s",
+             f ? scp_type_name(f->type) : "nothing");
+  free(f);
 
   /* Frames for jobs not in use. */
   scp_enc_points(&b, 42, 0, SCP_F64_XYZ, sphere, 10);

@@ -1,9 +1,11 @@
 /*
  * Job options (PROTOCOL.md 6.3): the daemon grants the JOB_OPTIONS feature
  * to a client that offers it, runs a job with its options exactly as the
- * core does with the same parameters, refuses a job whose options it does
- * not know or that are out of range, treats options on a connection
- * without the feature as a malformed frame, and serves on regardless.
+ * core does with the same parameters, sends the smoothed positions of a
+ * denoised job that asks for them (VERTICES), refuses a job whose options
+ * it does not know or that are out of range, treats options on a
+ * connection without the feature as a malformed frame, and serves on
+ * regardless.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -115,6 +117,52 @@ static void options_apply(void) {
   scdt_close(c);
 }
 
+/* smoothed_vertices: the core's smoothed positions, bit for bit, when the
+ * job was denoised (a given scale smooths even this clean torus), and no
+ * VERTICES at all when it was not. */
+static void options_vertices(void) {
+  scdt_conn_t *c = open_conn(SCP_FEATURE_JOB_OPTIONS);
+  const double scale = 0.15;
+  const scp_value_t smoothed[] = {
+      {.name = "denoise", .kind = SCP_KIND_U64, .v.u = 1},
+      {.name = "denoise_scale", .kind = SCP_KIND_F64, .v.f = scale},
+      {.name = "smoothed_vertices", .kind = SCP_KIND_U64, .v.u = 1}};
+  scdt_job_t with, unsmoothed;
+  scdt_job_init(&with, 1, torus, N);
+  with.options = smoothed;
+  with.noptions = sizeof smoothed / sizeof smoothed[0];
+  /* Without denoise nothing is smoothed, so there is nothing to send. */
+  scdt_job_init(&unsmoothed, 2, torus, N);
+  unsmoothed.options = &smoothed[2];
+  unsmoothed.noptions = 1;
+  run(c, &with);
+  run(c, &unsmoothed);
+
+  sc_params_t p;
+  sc_params_init(&p);
+  p.r = 0.25; /* the test client's r */
+  p.denoise = 1;
+  p.denoise_scale = scale;
+  p.smoothed_vertices = 1;
+  sc_mesh_t *m = direct(p);
+  ASSERT_MSG(m->diag.denoised && m->smoothed, "the core did not smooth");
+  EXPECT_MSG(same_mesh(&with, m), "smoothed job: %llu triangles, the core %zu",
+             (unsigned long long)with.ntri, m->triangle_count);
+  EXPECT_MSG(with.nvertices == N && memcmp(with.vertices, m->smoothed,
+                                           3 * N * sizeof(double)) == 0,
+             "smoothed job: %llu vertices, not the core's %d",
+             (unsigned long long)with.nvertices, N);
+  EXPECT_MSG(memcmp(with.vertices, torus, 3 * N * sizeof(double)) != 0,
+             "the vertices are the points as sent");
+  EXPECT_MSG(unsmoothed.done && unsmoothed.nvertices == 0,
+             "job without denoise: %llu vertices",
+             (unsigned long long)unsmoothed.nvertices);
+  sc_mesh_free(m);
+  scdt_job_reset(&with);
+  scdt_job_reset(&unsmoothed);
+  scdt_close(c);
+}
+
 /* A job refused at JOB_BEGIN with the code and a message naming text. */
 static void expect_refused(scdt_conn_t *c, uint32_t id, scp_value_t opt,
                            uint32_t code, const char *text) {
@@ -161,6 +209,10 @@ static void options_refused(void) {
        SCP_WIRE_INVALID, "out of range"},
       {{.name = "denoise_scale", .kind = SCP_KIND_U64, .v.u = 1},
        SCP_WIRE_INVALID, "must be"},
+      {{.name = "smoothed_vertices", .kind = SCP_KIND_U64, .v.u = 2},
+       SCP_WIRE_INVALID, "out of range"},
+      {{.name = "smoothed_vertices", .kind = SCP_KIND_F64, .v.f = 1},
+       SCP_WIRE_INVALID, "must be an unsigned integer"},
   };
   for (uint32_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
     expect_refused(c, 10 + i, cases[i].opt, cases[i].code, cases[i].says);
@@ -217,6 +269,7 @@ int main(int argc, char **argv) {
   ASSERT_MSG(scdt_daemon_start(&d, args) == 0, "daemon");
   features();
   options_apply();
+  options_vertices();
   options_refused();
   EXPECT_MSG(scdt_daemon_stop(&d) == 0, "daemon stop: status %d", d.status);
   free(sphere);

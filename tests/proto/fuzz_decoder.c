@@ -47,7 +47,8 @@ static void mix(trace_t *t, uint64_t v) {
 static uint64_t touch(const scp_msg_t *m) {
   uint64_t sum = 0;
   if (m->type == SCP_POINTS || m->type == SCP_NORMALS ||
-      m->type == SCP_TRIANGLES || m->type == SCP_COMPONENTS) {
+      m->type == SCP_VERTICES || m->type == SCP_TRIANGLES ||
+      m->type == SCP_COMPONENTS) {
     const scp_chunk_t *c = &m->u.chunk;
     for (uint32_t i = 0; i < c->count; i++) {
       double xyz[3];
@@ -118,7 +119,8 @@ static void check_frame(scp_decoder_t *d, int role, const scp_frame_t *f,
   /* Parsers refuse frames of other types without looking further. */
   scp_chunk_t c;
   if (f->type != SCP_POINTS && f->type != SCP_TRIANGLES &&
-      f->type != SCP_NORMALS && f->type != SCP_COMPONENTS)
+      f->type != SCP_NORMALS && f->type != SCP_VERTICES &&
+      f->type != SCP_COMPONENTS)
     FZ_ASSERT(scp_parse_chunk(f, &c) == SCP_EINVAL);
   scp_job_end_t je;
   if (f->type != SCP_JOB_END)

@@ -132,7 +132,7 @@ static void mesh(scp_buf_t *b) {
                         .normal_format = SCP_F32_XYZ,
                         .genus = genus,
                         .component_count = 1};
-  scp_mesh_cursor_t c = {0, 0, 0};
+  scp_mesh_cursor_t c = {0};
   int rc;
   while ((rc = scp_enc_mesh_next(b, &mv, &c)) == 1)
     ;
@@ -276,7 +276,7 @@ int main(int argc, char **argv) {
 
   /* Frames to skip or to answer with UNKNOWN_TYPE. */
   uint8_t junk[16] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
-  raw_frame(&b, 0x8001, 0, 16, junk, 16);
+  raw_frame(&b, 0x8fff, 0, 16, junk, 16);
   raw_frame(&b, 0x0099, 0, 3, junk, 3);
   raw_frame(&b, 0x0000, 0, 0, NULL, 0);
   E(scp_enc_ping(&b, 2));

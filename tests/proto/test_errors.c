@@ -61,7 +61,7 @@ static void test_truncation(void) {
 
   /* Ending inside an ignorable frame that is being skipped. */
   uint8_t ign[8 + 10];
-  pt_header(ign, 0x8001, 0, 10);
+  pt_header(ign, 0x8fff, 0, 10);
   memset(ign + 8, 0, 10);
   scp_decoder_t *d = decoder(SCP_ROLE_ANY, SCP_FRAME_MIN);
   scp_frame_t f;
@@ -421,6 +421,48 @@ static void test_unknown_type(void) {
   ASSERT_EQ(c.skipped, 1);
   ASSERT_EQ(c.frames, 1);
   scp_decoder_free(d);
+
+  /* VERTICES is ignorable but known: a server drops it like an unknown
+   * type (it travels the wrong way, PROTOCOL.md 3.2), a client gets it. */
+  scp_buf_t vb;
+  scp_buf_init(&vb, SCP_FRAME_MIN);
+  scp_hello_t hello = {
+      .version_min = 1, .version_max = 1, .max_frame = SCP_FRAME_MIN};
+  double xyz[3] = {1, 2, 3};
+  ASSERT_CODE_EQ(scp_enc_hello(&vb, &hello), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_vertices(&vb, 4, 0, xyz, 1), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_ping(&vb, 9), 0, scp_err_name);
+  d = decoder(SCP_ROLE_SERVER, SCP_FRAME_MIN);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, vb.data, vb.len), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, SCP_HELLO);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, SCP_PING);
+  scp_decoder_get_counters(d, &c);
+  ASSERT_EQ(c.skipped, 1);
+  scp_decoder_free(d);
+  scp_buf_consume(&vb, vb.len);
+
+  scp_welcome_t welcome = {.version = 1,
+                           .max_frame = SCP_FRAME_MIN,
+                           .max_jobs = 1,
+                           .max_points = 10};
+  ASSERT_CODE_EQ(scp_enc_welcome(&vb, &welcome), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_enc_vertices(&vb, 4, 0, xyz, 1), 0, scp_err_name);
+  d = decoder(SCP_ROLE_CLIENT, SCP_FRAME_MIN);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, vb.data, vb.len), 0, scp_err_name);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, SCP_WELCOME);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), 1, scp_err_name);
+  ASSERT_EQ(f.type, SCP_VERTICES);
+  ASSERT_CODE_EQ(scp_parse_as(&f, SCP_ROLE_CLIENT, &m), 0, scp_err_name);
+  ASSERT_EQ(m.u.chunk.job_id, 4);
+  ASSERT_CODE_EQ(scp_parse_as(&f, SCP_ROLE_SERVER, &m), SCP_EUNKNOWN_TYPE,
+                 scp_err_name);
+  scp_decoder_get_counters(d, &c);
+  ASSERT_EQ(c.skipped, 0);
+  scp_decoder_free(d);
+  scp_buf_free(&vb);
 }
 
 /* Builds a frame from a hex-free description: type plus payload bytes. */
@@ -496,10 +538,10 @@ static void test_wrong_lengths(void) {
   static const struct {
     uint16_t type;
     uint32_t size;
-  } var[] = {{SCP_HELLO, 24},     {SCP_WELCOME, 32},   {SCP_ERROR, 20},
-             {SCP_JOB_DONE, 32},  {SCP_JOB_ERROR, 16}, {SCP_STATS, 8},
-             {SCP_POINTS, 24},    {SCP_TRIANGLES, 24}, {SCP_NORMALS, 24},
-             {SCP_COMPONENTS, 24}};
+  } var[] = {{SCP_HELLO, 24},    {SCP_WELCOME, 32},   {SCP_ERROR, 20},
+             {SCP_JOB_DONE, 32}, {SCP_JOB_ERROR, 16}, {SCP_STATS, 8},
+             {SCP_POINTS, 24},   {SCP_TRIANGLES, 24}, {SCP_NORMALS, 24},
+             {SCP_VERTICES, 24}, {SCP_COMPONENTS, 24}};
   uint8_t hs[64] = {0};
   memcpy(hs, SCP_MAGIC, 4);
   for (size_t i = 0; i < sizeof var / sizeof var[0]; i++) {
@@ -708,10 +750,11 @@ static void test_reserved(void) {
   }
 
   /* The chunk frames' reserved word. */
-  uint16_t chunk_types[4] = {SCP_POINTS, SCP_TRIANGLES, SCP_NORMALS,
-                             SCP_COMPONENTS};
-  uint32_t formats[4] = {SCP_F32_XYZ, SCP_U32_TRIANGLE, SCP_F64_XYZ, SCP_I32};
-  for (int i = 0; i < 4; i++) {
+  uint16_t chunk_types[5] = {SCP_POINTS, SCP_TRIANGLES, SCP_NORMALS,
+                             SCP_VERTICES, SCP_COMPONENTS};
+  uint32_t formats[5] = {SCP_F32_XYZ, SCP_U32_TRIANGLE, SCP_F64_XYZ,
+                         SCP_F64_XYZ, SCP_I32};
+  for (int i = 0; i < 5; i++) {
     uint8_t p[24 + 24] = {0};
     pt_put32(p, 1);
     pt_put32(p + 4, 1);
@@ -923,6 +966,10 @@ static void test_ranges(void) {
       {SCP_POINTS, 1, 2, SCP_F32_XYZ, UINT64_MAX - 2, 0},
       {SCP_NORMALS, 1, 1, SCP_U32_TRIANGLE, 0, SCP_ERANGE},
       {SCP_NORMALS, 1, 1, SCP_F64_XYZ, 0, 0},
+      {SCP_VERTICES, 1, 1, SCP_F32_XYZ, 0, SCP_ERANGE},
+      {SCP_VERTICES, 1, 1, SCP_U32_TRIANGLE, 0, SCP_ERANGE},
+      {SCP_VERTICES, 0, 1, SCP_F64_XYZ, 0, SCP_ERANGE},
+      {SCP_VERTICES, 1, 2, SCP_F64_XYZ, 0, 0},
       {SCP_TRIANGLES, 1, 1, SCP_F32_XYZ, 0, SCP_ERANGE},
       {SCP_TRIANGLES, 1, 1, SCP_U32_TRIANGLE, 0, 0},
       {SCP_COMPONENTS, 1, 1, SCP_U32_TRIANGLE, 0, SCP_ERANGE},

@@ -439,6 +439,26 @@ static void test_chunks(void) {
   scp_decoder_free(d);
   scp_buf_consume(&b, b.len);
 
+  /* Smoothed positions travel as exact doubles, whatever their size. */
+  double vertices[6] = {0.1, -2.5e300, 1.0 / 3, 4e-310, 5, -0.0};
+  ASSERT_CODE_EQ(scp_enc_vertices(&b, 7, 3, vertices, 2), 0, scp_err_name);
+  d = reparse(&b, SCP_VERTICES, &m);
+  ASSERT_EQ(m.u.chunk.format, SCP_F64_XYZ);
+  ASSERT_EQ(m.u.chunk.first, 3);
+  ASSERT_EQ(m.u.chunk.count, 2);
+  double vback[6];
+  ASSERT_CODE_EQ(scp_chunk_copy_xyz(&m.u.chunk, vback), 0, scp_err_name);
+  for (int i = 0; i < 6; i++)
+    ASSERT_DBL_SAME(vback[i], vertices[i]);
+  scp_frame_t vf = {.type = SCP_VERTICES,
+                    .length = (uint32_t)b.len - SCP_HEADER_SIZE,
+                    .payload = b.data + SCP_HEADER_SIZE};
+  uint32_t vid = 0;
+  ASSERT(scp_frame_job_id(&vf, &vid));
+  ASSERT_EQ(vid, 7);
+  scp_decoder_free(d);
+  scp_buf_consume(&b, b.len);
+
   int32_t genus[4] = {-1, 0, 7, INT32_MAX};
   ASSERT_CODE_EQ(scp_enc_components(&b, 7, 0, genus, 4), 0, scp_err_name);
   d = reparse(&b, SCP_COMPONENTS, &m);
@@ -548,12 +568,15 @@ static void test_mesh_next(void) {
   enum { NT = 1000, NP = 502, NC = 1500 };
   uint32_t *tris = malloc(3 * NT * sizeof *tris);
   double *normals = malloc(3 * NP * sizeof *normals);
+  double *vertices = malloc(3 * NP * sizeof *vertices);
   int32_t *genus = malloc(NC * sizeof *genus);
-  ASSERT(tris && normals && genus);
+  ASSERT(tris && normals && vertices && genus);
   for (uint32_t i = 0; i < 3 * NT; i++)
     tris[i] = (i * 7919u) % NP;
-  for (uint32_t i = 0; i < 3 * NP; i++)
+  for (uint32_t i = 0; i < 3 * NP; i++) {
     normals[i] = (i % 3 == 2) ? 1.0 : 0.0;
+    vertices[i] = i / 7.0;
+  }
   for (int32_t i = 0; i < NC; i++)
     genus[i] = i % 5 - 1;
   scp_mesh_view_t mv = {.job_id = 11,
@@ -562,9 +585,11 @@ static void test_mesh_next(void) {
                         .normals = normals,
                         .normal_count = NP,
                         .normal_format = SCP_F64_XYZ,
+                        .vertices = vertices,
+                        .vertex_count = NP,
                         .genus = genus,
                         .component_count = NC};
-  scp_mesh_cursor_t cur = {0, 0, 0};
+  scp_mesh_cursor_t cur = {0};
   scp_buf_t b;
   scp_buf_init(&b, SCP_FRAME_MIN);
   int rc;
@@ -575,7 +600,8 @@ static void test_mesh_next(void) {
   scp_decoder_t *d = scp_decoder_new(NULL);
   ASSERT_NOT_NULL(d);
   ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
-  uint64_t seen[3] = {0, 0, 0};
+  /* Triangles, normals, vertices, components: in this order. */
+  uint64_t seen[4] = {0, 0, 0, 0};
   uint64_t frames = 0;
   scp_frame_t f;
   while ((rc = scp_decoder_next(d, &f)) == 1) {
@@ -584,7 +610,7 @@ static void test_mesh_next(void) {
     ASSERT_EQ(c.job_id, 11);
     frames++;
     if (c.type == SCP_TRIANGLES) {
-      ASSERT_EQ(seen[1] + seen[2], 0); /* triangles come first */
+      ASSERT_EQ(seen[1] + seen[2] + seen[3], 0); /* triangles come first */
       ASSERT_EQ(c.first, seen[0]);
       for (uint32_t i = 0; i < c.count; i++) {
         uint32_t t[3];
@@ -594,29 +620,44 @@ static void test_mesh_next(void) {
       }
       seen[0] += c.count;
     } else if (c.type == SCP_NORMALS) {
-      ASSERT_EQ(seen[2], 0);
+      ASSERT_EQ(seen[2] + seen[3], 0);
       ASSERT_EQ(c.first, seen[1]);
       ASSERT_EQ(c.format, SCP_F64_XYZ);
       seen[1] += c.count;
+    } else if (c.type == SCP_VERTICES) {
+      ASSERT_EQ(seen[1], NP); /* after every normal */
+      ASSERT_EQ(seen[3], 0);
+      ASSERT_EQ(c.first, seen[2]);
+      ASSERT_EQ(c.format, SCP_F64_XYZ);
+      for (uint32_t i = 0; i < c.count; i++) {
+        double xyz[3];
+        scp_chunk_xyz(&c, i, xyz);
+        for (int k = 0; k < 3; k++)
+          ASSERT_DBL_SAME(xyz[k], vertices[3 * (c.first + i) + (uint64_t)k]);
+      }
+      seen[2] += c.count;
     } else {
       ASSERT_EQ(c.type, SCP_COMPONENTS);
-      ASSERT_EQ(c.first, seen[2]);
+      ASSERT_EQ(c.first, seen[3]);
       for (uint32_t i = 0; i < c.count; i++)
         ASSERT_EQ(scp_chunk_i32(&c, i), genus[c.first + i]);
-      seen[2] += c.count;
+      seen[3] += c.count;
     }
   }
   ASSERT_CODE_EQ(rc, 0, scp_err_name);
   ASSERT_CODE_EQ(scp_decoder_eof(d), 0, scp_err_name);
   ASSERT_EQ(seen[0], NT);
   ASSERT_EQ(seen[1], NP);
-  ASSERT_EQ(seen[2], NC);
-  /* 338 triangles, 169 f64 normals and 1016 genera per 4 KiB frame. */
-  ASSERT_EQ(frames, 3 + 3 + 2);
+  ASSERT_EQ(seen[2], NP);
+  ASSERT_EQ(seen[3], NC);
+  /* 338 triangles, 169 f64 normals or vertices and 1016 genera per 4 KiB
+   * frame. */
+  ASSERT_EQ(frames, 3 + 3 + 3 + 2);
   scp_decoder_free(d);
   scp_buf_free(&b);
   free(tris);
   free(normals);
+  free(vertices);
   free(genus);
 }
 

@@ -88,7 +88,7 @@ static void check_document(const char *path) {
       check_row(section, cells, n, &seen);
   }
   fclose(fp);
-  ASSERT_EQ(seen.types, 18);
+  ASSERT_EQ(seen.types, 19);
   ASSERT_EQ(seen.errors, 17);
   ASSERT_EQ(seen.modes, SCP_MODE_COUNT);
   ASSERT_EQ(seen.stages, SCP_STAGE_COUNT);
