@@ -434,7 +434,7 @@ const char *sc_diag_element_name(const sc_diag_info_t *row, size_t i);
  * no help, and on a coarse sample what the estimate takes for noise is the
  * shape, which smoothing would flatten. A denoise_scale given by the
  * caller smooths whatever the estimate. (docs/algorithm.md section 16.) */
-#define SC_NOISE_FLOOR 0.12
+#define SC_NOISE_FLOOR 0.10
 
 /* Values of sc_diag_t.path: X(NAME, value, name).
  *  - SHORTCRUST: the paper's criteria.
