@@ -323,6 +323,24 @@ int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
   return SC_EXIT_OK;
 }
 
+/* An empty mesh, or one that leaves most samples in no triangle, is
+ * written like any other but must not pass for an ordinary result
+ * (PROTOCOL.md 6.9): one warning line on stderr, even with --quiet. The
+ * counts decide too, for a daemon that does not send mostly_unused. */
+static void warn_sparse(const sc_cli_result_t *r) {
+  const sc_diag_t *d = r->diag;
+  fflush(stdout); /* after the summary, when both go to one place */
+  if (d->triangles == 0)
+    sc_cli_error("warning: %s: the mesh is empty: the points support no "
+                 "surface that mode %s accepts",
+                 r->output, sc_mode_name(r->params.mode));
+  else if (d->mostly_unused || 2 * d->samples_unused > d->delaunay_vertices)
+    sc_cli_error("warning: %s: %llu of %llu distinct samples are in no "
+                 "triangle",
+                 r->output, (unsigned long long)d->samples_unused,
+                 (unsigned long long)d->delaunay_vertices);
+}
+
 int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
                      scf_mesh_format_t fmt, const scf_points_t *pts,
                      const uint32_t *tris, size_t ntri,
@@ -343,5 +361,6 @@ int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
     status = SC_EXIT_FAILURE;
   if (!o->quiet)
     sc_cli_summary(stdout, r);
+  warn_sparse(r);
   return status;
 }

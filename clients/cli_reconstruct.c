@@ -28,7 +28,8 @@ static void usage(FILE *f) {
   sc_cli_job_usage_output(f);
   fputs("Progress goes to stderr when it is a terminal; the summary goes to\n"
         "stdout. Exit status: 0 done, 1 failed (the message says why), 2 bad\n"
-        "command line.\n",
+        "command line. A mesh that is empty or leaves most samples in no\n"
+        "triangle is written with status 0 and a warning line on stderr.\n",
         f);
 }
 

@@ -37,7 +37,9 @@ static void usage(FILE *f) {
   sc_cli_job_usage_output(f);
   fputs("Progress (upload, each stage on the daemon, download) goes to stderr\n"
         "when it is a terminal; the summary goes to stdout. Exit status: 0\n"
-        "done, 1 failed (the message says why), 2 bad command line.\n",
+        "done, 1 failed (the message says why), 2 bad command line. A mesh\n"
+        "that is empty or leaves most samples in no triangle is written with\n"
+        "status 0 and a warning line on stderr.\n",
         f);
 }
 

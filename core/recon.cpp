@@ -369,6 +369,19 @@ std::vector<double> normals_by_input(const std::vector<double> &acc,
   return normals;
 }
 
+// Four points in general position make a single Delaunay cell, and the
+// only surface they support is its boundary, the four facets of the hull.
+// The candidate tests may pass them, but pruning cannot keep them: the
+// facets meet at edges sharper than a right angle, which is what pruning
+// removes (section 7), and a job of four points would come back empty. So
+// a single cell is its own surface, in every mode; describe() orients it
+// outward.
+void single_cell_surface(const double *lxyz, Progress &progress, Surface &surf,
+                         sc_diag_t &diag) {
+  std::vector<uint32_t> tris = {0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2};
+  describe(lxyz, 4, tris, progress, surf, diag);
+}
+
 // The mesh handed back to C, in malloc'ed arrays.
 sc_mesh_t *mesh_out(const Surface &surf, const std::vector<double> &normals,
                     size_t n, const sc_diag_t &diag) {
@@ -489,6 +502,9 @@ sc_mesh_t *Recon::finish() {
         attach_samples(lxyz.data(), m, surf, progress, diag);
   }
 
+  if (diag.delaunay_cells == 1 && m == 4)
+    single_cell_surface(lxyz.data(), progress, surf, diag);
+
   std::vector<double> acc = vertex_normals(lxyz, m, surf.tris, f.poles);
   // Back to input indices.
   lxyz = std::vector<double>();
@@ -497,6 +513,11 @@ sc_mesh_t *Recon::finish() {
     v = f.to_input[v];
   canonical_order(surf.tris, true);
   seconds_[SC_STAGE_EXTRACT] += sw.lap();
+
+  // An empty mesh, or one that leaves most samples out, is a result the
+  // caller must not take for an ordinary success: the points do not look
+  // like a surface this mode can reconstruct (PROTOCOL.md 6.9).
+  diag.mostly_unused = 2 * diag.samples_unused > diag.delaunay_vertices;
 
   for (int s = 0; s < SC_STAGE_COUNT; ++s) {
     diag.seconds[s] = seconds_[s];

@@ -334,6 +334,9 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
     "triangles added to close them")                                           \
   X(samples_unused, uint64_t, , COUNT, "samples_unused",                       \
     "distinct samples in no output triangle")                                  \
+  X(mostly_unused, int, , BOOL, "mostly_unused",                               \
+    "1 when more than half of the distinct samples are in no output "          \
+    "triangle (so always when the output is empty), else 0")                   \
   X(boundary_edges, uint64_t, , COUNT, "boundary_edges",                       \
     "output edges with a single triangle")                                     \
   X(boundary_loops, uint64_t, , COUNT, "boundary_loops",                       \

@@ -201,7 +201,8 @@ void scd_on_job_begin(scd_conn_t *c, const scp_frame_t *f) {
     return;
   }
   if (c->njobs >= srv->cfg.max_jobs) {
-    scd_conn_fatal(c, SCP_WIRE_LIMIT, id, f->type,
+    /* A fatal ERROR ends every job, so it names none (PROTOCOL.md 6.1). */
+    scd_conn_fatal(c, SCP_WIRE_LIMIT, 0, f->type,
                    "more than %u jobs in use on one connection",
                    srv->cfg.max_jobs);
     return;
@@ -350,19 +351,22 @@ void scd_on_points(scd_conn_t *c, const scp_frame_t *f) {
                         (ull)ch.first, (ull)j->received);
     return;
   }
+  /* Past an announced count the client broke its own word (INVALID);
+   * only a job that announced none can reach max_points (LIMIT), since
+   * the count was checked against it (PROTOCOL.md 7.3). */
   uint64_t total = j->received + ch.count;
+  if (j->declared && total > j->declared) {
+    scd_job_fail_upload(c, j, SCP_WIRE_INVALID,
+                        "more points than the %llu JOB_BEGIN announced",
+                        (ull)j->declared);
+    return;
+  }
   if (total > srv->max_points) {
     scd_job_fail_upload(
         c, j, SCP_WIRE_LIMIT,
         "more than %llu points; this server takes at most %llu per "
         "job",
         (ull)(total - 1), (ull)srv->max_points);
-    return;
-  }
-  if (j->declared && total > j->declared) {
-    scd_job_fail_upload(c, j, SCP_WIRE_INVALID,
-                        "more points than the %llu JOB_BEGIN announced",
-                        (ull)j->declared);
     return;
   }
   if (!j->declared) {

@@ -241,12 +241,18 @@ void scd_conn_shutdown(scd_conn_t *c) {
       continue;
     const char *msg;
     if (!srv->grace_over) {
-      /* Only jobs that no worker has started end now. */
-      if (!j->task || !j->task->submitted ||
-          !scd_pool_withdraw(srv->pool, j->task))
+      /* Jobs still uploading end now, whether or not a worker is
+       * inserting a batch of their points at this moment: their points
+       * may never all come (PROTOCOL.md 8.5). Of the others, only those
+       * that no worker has started end now. */
+      int withdrawn = j->task && j->task->submitted &&
+                      scd_pool_withdraw(srv->pool, j->task);
+      if (withdrawn)
+        srv->tasks_in_pool--;
+      else if (j->phase != SCD_JOB_UPLOADING)
         continue;
-      srv->tasks_in_pool--;
-      msg = "server shutting down; the job had not started";
+      msg = withdrawn ? "server shutting down; the job had not started"
+                      : "server shutting down; the job was still uploading";
     } else {
       msg = "server shutting down; grace period over";
     }

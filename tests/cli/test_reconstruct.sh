@@ -104,6 +104,20 @@ checked=$("$info" "$tmp/b.ply" | sed -n 's/.* genus_all=\([0-9-]*\).*/\1/p')
   fail "open bunny: summary says genus '$said', the checker '$checked'"
 
 # Bad input: status 1, a message naming the file, an old output kept.
+# Four points give the four faces of their hull; a mesh that is empty is
+# written with status 0, but never silently (PROTOCOL.md 6.9).
+printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n' > "$tmp/tet.xyz"
+for mode in shortcrust cocone boundary watertight auto; do
+  expect 0 "4 triangles" "$sc" reconstruct "$tmp/tet.xyz" -o "$tmp/tet.off" --mode $mode
+  grep -q "Closed 2-manifold, 1 component, genus 0" "$tmp/out" || fail "tetrahedron, $mode: $(cat "$tmp/out")"
+  [ -s "$tmp/err" ] && fail "tetrahedron, $mode: $(cat "$tmp/err")"
+done
+printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n0.3 0.3 0.3\n' > "$tmp/five.xyz"
+expect 0 "" "$sc" reconstruct "$tmp/five.xyz" -o "$tmp/five.off" --quiet --report "$tmp/five.json"
+grep -q "^shortcrust: warning: .*the mesh is empty" "$tmp/err" || fail "an empty mesh without a warning: $(cat "$tmp/err")"
+grep -q '"mostly_unused": true' "$tmp/five.json" || fail "report lacks \"mostly_unused\": true"
+rm -f "$tmp/tet.xyz" "$tmp/tet.off" "$tmp/five.xyz" "$tmp/five.off" "$tmp/five.json"
+
 echo "keep" > "$tmp/old.ply"
 expect 1 "missing.ply" "$sc" reconstruct "$tmp/missing.ply" -o "$tmp/old.ply"
 printf '0 0 0\n1 0 0\n0 nan 1\n0 0 1\n1 1 1\n' > "$tmp/nan.xyz"

@@ -73,6 +73,15 @@ for in in knot1_points kitten_points noisy; do
   done
 done
 
+# Through the daemon too, four points give their hull, and an empty mesh
+# comes with a warning line and status 0 (PROTOCOL.md 6.9).
+printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n' > "$tmp/tet.xyz"
+expect 0 "4 triangles" "$sc" submit "$tmp/tet.xyz" -o "$tmp/tet.off" --socket "$sock"
+[ -s "$tmp/err" ] && fail "submit of a tetrahedron: $(cat "$tmp/err")"
+printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n0.3 0.3 0.3\n' > "$tmp/five.xyz"
+expect 0 "" "$sc" submit "$tmp/five.xyz" -o "$tmp/five.off" --socket "$sock" --quiet
+grep -q "^shortcrust: warning: .*the mesh is empty" "$tmp/err" || fail "submit of an empty mesh without a warning: $(cat "$tmp/err")"
+
 # The smoothed positions are written, not the points of the file: the
 # first vertex differs from the one written without --smoothed-vertices,
 # while the triangles and the local command's file are the same.

@@ -268,6 +268,7 @@ void scdt_job_init(scdt_job_t *j, uint32_t id, const double *xyz,
   j->r = 0.25;
   j->format = SCP_F64_XYZ;
   j->declare = 1;
+  j->diag_mostly_unused = -1;
 }
 
 void scdt_job_reset(scdt_job_t *j) {
@@ -489,6 +490,8 @@ static int collect_one(scdt_conn_t *c, scdt_job_t **jobs, size_t njobs,
       j->diag_triangles = v.v.u;
     if (scp_values_find(&d->values, "genus", &it, &v))
       j->diag_genus = v.v.i;
+    if (scp_values_find(&d->values, "mostly_unused", &it, &v))
+      j->diag_mostly_unused = (int)v.v.u;
     j->done = 1;
     j->ended = 1;
     return 0;

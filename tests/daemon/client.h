@@ -96,6 +96,7 @@ typedef struct scdt_job {
   unsigned progress;   /* PROGRESS frames */
   uint64_t diag_triangles; /* "triangles" from JOB_DONE */
   int64_t diag_genus;
+  int diag_mostly_unused; /* "mostly_unused" from JOB_DONE; -1 if absent */
 } scdt_job_t;
 
 void scdt_job_init(scdt_job_t *j, uint32_t id, const double *xyz, uint64_t n);

@@ -118,7 +118,9 @@ static void expected(scp_buf_t *b, const char *name) {
     scp_accepted_t a = {.job_id = 7, .queue_position = 0};
     ASSERT_CODE_EQ(scp_enc_accepted(b, &a), 0, scp_err_name);
   } else if (strcmp(name, "TRIANGLES") == 0) {
-    uint32_t t[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    /* In the order the daemon sends them (canonical_order() in the core:
+     * each rotated to its smallest index, then sorted). */
+    uint32_t t[12] = {0, 1, 3, 0, 2, 1, 0, 3, 2, 1, 2, 3};
     ASSERT_CODE_EQ(scp_enc_triangles(b, 7, 0, t, 4), 0, scp_err_name);
   } else if (strcmp(name, "COMPONENTS") == 0) {
     int32_t genus[1] = {0};
@@ -149,6 +151,48 @@ static void check_tetrahedron(const scp_chunk_t *c) {
     for (int b2 = 0; b2 < 4; b2++)
       if (a != b2)
         ASSERT_EQ(used[a][b2], 1);
+}
+
+/* The stream rules of sections 3.1, 3.2 and 8.2, as a server's decoder
+ * applies them: frames after HELLO are judged by the limit set once
+ * WELCOME is out, even when they came in the same read; a WELCOME from a
+ * client is a second handshake frame (fatal), not a misdirected one; and a
+ * stream that ends inside a frame is an end of stream, not a frame. */
+static void stream_rules(void) {
+  scp_limits_t lim;
+  scp_limits_init(&lim);
+  lim.role = SCP_ROLE_SERVER;
+  scp_buf_t b;
+  scp_buf_init(&b, 1u << 20);
+  scp_hello_t h = {.version_min = 1, .version_max = 1, .max_frame = 1u << 20};
+  ASSERT_CODE_EQ(scp_enc_hello(&b, &h), 0, scp_err_name);
+  double xyz[3 * 400] = {0};
+  ASSERT_CODE_EQ(scp_enc_points(&b, 1, 0, SCP_F64_XYZ, xyz, 400), 0,
+                 scp_err_name);
+  ASSERT_GT(b.len, SCP_FRAME_MIN);
+  scp_welcome_t w = {
+      .version = 1, .max_frame = 1u << 20, .max_jobs = 1, .max_points = 4};
+  ASSERT_CODE_EQ(scp_enc_welcome(&b, &w), 0, scp_err_name);
+
+  scp_decoder_t *d = scp_decoder_new(&lim);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, b.len), 0, scp_err_name);
+  scp_frame_t f;
+  ASSERT_EQ(scp_decoder_next(d, &f), 1);
+  ASSERT_EQ(f.type, SCP_HELLO);
+  ASSERT_CODE_EQ(scp_decoder_set_max_frame(d, 1u << 20), 0, scp_err_name);
+  ASSERT_EQ(scp_decoder_next(d, &f), 1);
+  ASSERT_EQ(f.type, SCP_POINTS);
+  ASSERT_CODE_EQ(scp_decoder_next(d, &f), SCP_EHANDSHAKE, scp_err_name);
+  ASSERT(scp_err_is_fatal(SCP_EHANDSHAKE));
+  ASSERT_EQ(scp_err_to_wire(SCP_EHANDSHAKE), SCP_WIRE_PROTOCOL);
+  scp_decoder_free(d);
+
+  d = scp_decoder_new(&lim);
+  ASSERT_CODE_EQ(scp_decoder_feed(d, b.data, 20), 0, scp_err_name);
+  ASSERT_EQ(scp_decoder_next(d, &f), 0);
+  ASSERT_CODE_EQ(scp_decoder_eof(d), SCP_ETRUNCATED, scp_err_name);
+  scp_decoder_free(d);
+  scp_buf_free(&b);
 }
 
 int main(int argc, char **argv) {
@@ -209,5 +253,6 @@ int main(int argc, char **argv) {
     scp_decoder_free(d);
     scp_buf_free(&b);
   }
+  stream_rules();
   return sct_finish("proto_spec");
 }
