@@ -31,23 +31,31 @@
 #include "shortcrust_files.h"
 #include "synth.h"
 
-static void check(const scf_points_t *pts, sc_mode_t mode) {
+/* The mesh of the n points in mode, with or without --denoise; NULL (and
+ * a failed check) when the core refuses them. */
+static sc_mesh_t *reconstruct(const double *xyz, size_t n, sc_mode_t mode,
+                              int denoise) {
   sc_params_t p;
   sc_params_init(&p);
   p.mode = mode;
-  p.denoise = 1;
+  p.denoise = denoise;
   char msg[512];
   sc_mesh_t *m = NULL;
-  int rc = sc_reconstruct(pts->xyz, pts->count, &p, &m, msg, sizeof msg);
+  int rc = sc_reconstruct(xyz, n, &p, &m, msg, sizeof msg);
   EXPECT_EQ(rc, 0);
-  if (rc != 0) {
+  if (rc != 0)
     fprintf(stderr, "%s\n", msg);
+  return m;
+}
+
+/* The criteria at the top, for the merged scans in mode with --denoise. */
+static void check(const double *xyz, size_t n, sc_mode_t mode) {
+  sc_mesh_t *m = reconstruct(xyz, n, mode, 1);
+  if (!m)
     return;
-  }
   EXPECT_EQ(m->diag.denoised, 1);
   scs_meshcheck_t c;
-  EXPECT_EQ(scs_meshcheck(pts->count, pts->xyz, m->triangles, m->triangle_count,
-                          NULL, &c),
+  EXPECT_EQ(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
             0);
   char line[512];
   printf("%s --denoise: %s; noise %.2f spacings\n", sc_mode_name(mode),
@@ -55,7 +63,7 @@ static void check(const scf_points_t *pts, sc_mode_t mode) {
   EXPECT(c.manifold);
   EXPECT(c.oriented);
   EXPECT_EQ(c.components, 1);
-  EXPECT_GE(c.vertices_used * 100, 99 * pts->count);
+  EXPECT_GE(c.vertices_used * 100, 99 * n);
   if (c.component_count == 1)
     EXPECT_EQ(c.comp[0].genus, 0);
   if (mode == SC_MODE_WATERTIGHT) {
@@ -69,26 +77,15 @@ static void check(const scf_points_t *pts, sc_mode_t mode) {
   sc_mesh_free(m);
 }
 
-/* The components of the mesh of pts in mode, with or without denoising;
- * whether it was denoised in *denoised. */
-static uint64_t pieces(const double *xyz, size_t n, sc_mode_t mode, int denoise,
+/* The components of the mesh of the points in mode, without --denoise;
+ * whether the mode smoothed them by itself in *denoised. */
+static uint64_t pieces(const double *xyz, size_t n, sc_mode_t mode,
                        int *denoised) {
-  sc_params_t p;
-  sc_params_init(&p);
-  p.mode = mode;
-  p.denoise = denoise;
-  char msg[512];
-  sc_mesh_t *m = NULL;
-  int rc = sc_reconstruct(xyz, n, &p, &m, msg, sizeof msg);
-  EXPECT_EQ(rc, 0);
-  if (rc != 0) {
-    fprintf(stderr, "%s\n", msg);
+  sc_mesh_t *m = reconstruct(xyz, n, mode, 0);
+  if (!m)
     return 0;
-  }
-  printf("%s%s: %llu components, genus %lld, %llu loops; noise %.3f "
-         "spacings\n",
-         sc_mode_name(mode), denoise ? " --denoise" : "",
-         (unsigned long long)m->diag.components, (long long)m->diag.genus,
+  printf("%s: %llu components, %llu loops; noise %.3f spacings\n",
+         sc_mode_name(mode), (unsigned long long)m->diag.components,
          (unsigned long long)m->diag.boundary_loops, m->diag.noise);
   *denoised = m->diag.denoised;
   uint64_t c = m->diag.components;
@@ -99,8 +96,8 @@ static uint64_t pieces(const double *xyz, size_t n, sc_mode_t mode, int denoise,
 /* Single views overlapping over part of the surface (see the top). */
 static void check_partial(const double *xyz, size_t n) {
   int plain = 0, in_auto = 0;
-  uint64_t before = pieces(xyz, n, SC_MODE_BOUNDARY, 0, &plain);
-  uint64_t after = pieces(xyz, n, SC_MODE_AUTO, 0, &in_auto);
+  uint64_t before = pieces(xyz, n, SC_MODE_BOUNDARY, &plain);
+  uint64_t after = pieces(xyz, n, SC_MODE_AUTO, &in_auto);
   EXPECT_EQ(plain, 0);
   EXPECT_EQ(in_auto, 1);
   EXPECT_LT(after, before);
@@ -137,9 +134,8 @@ int main(int argc, char **argv) {
   if (partial) {
     check_partial(xyz, n);
   } else {
-    scf_points_t all = {.xyz = xyz, .count = n};
-    check(&all, SC_MODE_BOUNDARY);
-    check(&all, SC_MODE_WATERTIGHT);
+    check(xyz, n, SC_MODE_BOUNDARY);
+    check(xyz, n, SC_MODE_WATERTIGHT);
   }
   free(xyz);
   return sct_finish("core_multiview");

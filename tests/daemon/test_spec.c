@@ -175,6 +175,17 @@ static void beyond_count(void) {
   scdt_close(c);
 }
 
+/* Runs job id on c over the n points with the options; the caller resets
+ * j. */
+static void run_options(scdt_conn_t *c, scdt_job_t *j, uint32_t id,
+                        const double *xyz, uint64_t n,
+                        const scp_value_t *options, uint32_t noptions) {
+  scdt_job_init(j, id, xyz, n);
+  j->options = options;
+  j->noptions = noptions;
+  run(c, j);
+}
+
 /* 6.3: an option of a kind no value list defines is refused, not skipped;
  * the name is judged first; a repeated name's later entries are not
  * checked at all. */
@@ -184,32 +195,24 @@ static void option_kinds(void) {
   c->features = SCP_FEATURE_JOB_OPTIONS;
   ASSERT_MSG(scdt_handshake(c, 1u << 20) == 0, "handshake");
   double *xyz = scdt_sample(SCS_SURF_SPHERE, 500, 4);
+  scdt_job_t j;
+
   scp_value_t twice[2] = {
       {.name = "denoise", .kind = SCP_KIND_U64, .v.u = 1},
       {.name = "denoise", .kind = SCP_KIND_F64, .v.f = 7.5}};
-  scdt_job_t j;
-  scdt_job_init(&j, 1, xyz, 500);
-  j.options = twice;
-  j.noptions = 2;
-  run(c, &j);
+  run_options(c, &j, 1, xyz, 500, twice, 2);
   EXPECT_MSG(j.done, "a repeated name: want JOB_DONE, got %s (%s)",
              scp_wire_name(j.error_code), j.error_msg);
   scdt_job_reset(&j);
 
   scp_value_t odd = {.name = "denoise", .kind = 4, .v.u = 1};
-  scdt_job_init(&j, 2, xyz, 500);
-  j.options = &odd;
-  j.noptions = 1;
-  run(c, &j);
+  run_options(c, &j, 2, xyz, 500, &odd, 1);
   EXPECT_MSG(j.error_code == SCP_WIRE_INVALID, "kind 4: want INVALID, got %s",
              j.done ? "JOB_DONE" : scp_wire_name(j.error_code));
   scdt_job_reset(&j);
 
   scp_value_t unknown = {.name = "no_such_option", .kind = 4, .v.u = 1};
-  scdt_job_init(&j, 3, xyz, 500);
-  j.options = &unknown;
-  j.noptions = 1;
-  run(c, &j);
+  run_options(c, &j, 3, xyz, 500, &unknown, 1);
   EXPECT_MSG(j.error_code == SCP_WIRE_UNSUPPORTED,
              "unknown name of kind 4: want UNSUPPORTED, got %s",
              j.done ? "JOB_DONE" : scp_wire_name(j.error_code));
