@@ -8,8 +8,16 @@
  *      once, with 1 .. --workers-max workers.
  *   3. Memory: the daemon's resident size idle, at the peak of a burst,
  *      and once the burst is over.
+ *   4. Round trip: `shortcrust submit` of a --points torus file to a
+ *      one-worker daemon against `shortcrust reconstruct` of it, as whole
+ *      processes (bench_cmd.c).
+ *   5. Streaming: --stream-points points uploaded at a pace that spreads
+ *      them over --stream-seconds, in random and in scan order, then
+ *      JOB_END: the time to JOB_DONE against `shortcrust reconstruct` of
+ *      the same points (bench_cmd.c).
  *
- * Every figure is the median of --repeat runs. Meshes are checked (closed
+ * Every figure is the median of --repeat runs (alternated with the run it
+ * is compared with). Meshes are checked (closed
  * sphere) so that a fast wrong answer does not count.
  *
  * Copyright (C) 2026 the shortcrust authors.
@@ -23,73 +31,10 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "bench.h"
 #include "harness.h"
 #include "shortcrust.h"
 #include "synth.h"
-
-#define T_MS 600000
-
-static int cmp_double(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n) {
-  qsort(v, (size_t)n, sizeof *v, cmp_double);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-static double seconds(void) { return (double)scdt_now_ms() / 1e3; }
-
-/* Resident size of a process, bytes; 0 when unknown. */
-static uint64_t rss_of(pid_t pid) {
-  char path[64], line[256];
-  snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
-  FILE *f = fopen(path, "r");
-  if (!f)
-    return 0;
-  uint64_t kb = 0;
-  while (fgets(line, sizeof line, f))
-    if (sscanf(line, "VmRSS: %llu kB", (unsigned long long *)&kb) == 1)
-      break;
-  fclose(f);
-  return kb * 1024;
-}
-
-/* CPU seconds a process has used (user and system); 0 when unknown. */
-static double cpu_of(pid_t pid) {
-  char path[64];
-  snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
-  FILE *f = fopen(path, "r");
-  if (!f)
-    return 0;
-  char buf[2048];
-  size_t n = fread(buf, 1, sizeof buf - 1, f);
-  fclose(f);
-  buf[n] = '\0';
-  /* Fields 14 and 15, counted after the command name in parentheses. */
-  char *p = strrchr(buf, ')');
-  unsigned long long ut = 0, st = 0;
-  if (!p || sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu "
-                          "%llu",
-                   &ut, &st) != 2)
-    return 0;
-  return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
-}
-
-static double cpu_self(void) {
-  struct rusage ru;
-  getrusage(RUSAGE_SELF, &ru);
-  return (double)ru.ru_utime.tv_sec + ru.ru_utime.tv_usec / 1e6 +
-         (double)ru.ru_stime.tv_sec + ru.ru_stime.tv_usec / 1e6;
-}
-
-static int start(scdt_daemon_t *d, unsigned workers) {
-  char w[16];
-  snprintf(w, sizeof w, "%u", workers);
-  const char *args[] = {"--workers", w, "--log-level", "warn", NULL};
-  return scdt_daemon_start(d, args);
-}
 
 /* One job through a connection; seconds, or -1. */
 static double one_job(const char *sock, const double *xyz, size_t n,
@@ -101,11 +46,11 @@ static double one_job(const char *sock, const double *xyz, size_t n,
   scdt_job_init(&j, 1, xyz, n);
   scdt_job_t *pj = &j;
   char why[512] = "";
-  double t0 = seconds();
+  double t0 = bench_seconds();
   int rc = scdt_job_send(c, &j);
   if (rc == 0)
-    rc = scdt_collect(c, &pj, 1, T_MS, why, sizeof why);
-  double t = seconds() - t0;
+    rc = scdt_collect(c, &pj, 1, BENCH_T_MS, why, sizeof why);
+  double t = bench_seconds() - t0;
   if (rc != 0 || !j.done) {
     fprintf(stderr, "job failed: %s %s\n", why, j.error_msg);
     t = -1;
@@ -131,28 +76,28 @@ static void latency(size_t n, int repeat) {
   sc_params_t p;
   sc_params_init(&p);
   scdt_daemon_t d;
-  if (start(&d, 1) != 0) {
+  if (bench_start(&d, 1) != 0) {
     fprintf(stderr, "daemon did not start\n");
     exit(1);
   }
   /* Alternated, so that a change in the machine's load hits both alike. */
   for (int r = 0; r < repeat; r++) {
     sc_mesh_t *m = NULL;
-    double c0 = cpu_self();
-    double t0 = seconds();
+    double c0 = bench_cpu_self();
+    double t0 = bench_seconds();
     int rc = sc_reconstruct(xyz, n, &p, &m, NULL, 0);
-    direct[r] = seconds() - t0;
-    dcpu[r] = cpu_self() - c0;
+    direct[r] = bench_seconds() - t0;
+    dcpu[r] = bench_cpu_self() - c0;
     if (rc == 0)
       direct_tri = m->triangle_count;
     sc_mesh_free(m);
-    c0 = cpu_of(d.pid);
+    c0 = bench_cpu_of(d.pid);
     daemon[r] = one_job(d.sock, xyz, n, &daemon_tri);
-    scpu[r] = cpu_of(d.pid) - c0;
+    scpu[r] = bench_cpu_of(d.pid) - c0;
     pair[r] = daemon[r] / direct[r];
   }
   scdt_daemon_stop(&d);
-  double a = median(direct, repeat), b = median(daemon, repeat);
+  double a = bench_median(direct, repeat), b = bench_median(daemon, repeat);
   printf("  direct sc_reconstruct  %8.3f s  (%llu triangles)\n", a,
          (unsigned long long)direct_tri);
   printf("  through the daemon     %8.3f s  (%llu triangles, upload and "
@@ -160,10 +105,10 @@ static void latency(size_t n, int repeat) {
          b, (unsigned long long)daemon_tri);
   printf("  ratio daemon/direct    %8.3f  (median of the %d paired ratios: "
          "%.3f)\n",
-         b / a, repeat, median(pair, repeat));
+         b / a, repeat, bench_median(pair, repeat));
   printf("  CPU: direct %.3f s, daemon %.3f s (ratio %.3f)\n",
-         median(dcpu, repeat), median(scpu, repeat),
-         median(scpu, repeat) / median(dcpu, repeat));
+         bench_median(dcpu, repeat), bench_median(scpu, repeat),
+         bench_median(scpu, repeat) / bench_median(dcpu, repeat));
   free(direct);
   free(daemon);
   free(pair);
@@ -197,9 +142,9 @@ static void *burst_client(void *arg) {
       atomic_fetch_add(b->failed, 1);
   }
   char why[512] = "";
-  if (scdt_collect(c, pj, (size_t)b->count, T_MS, why, sizeof why) != 0)
+  if (scdt_collect(c, pj, (size_t)b->count, BENCH_T_MS, why, sizeof why) != 0)
     fprintf(stderr, "burst: %s\n", why);
-  b->end = seconds();
+  b->end = bench_seconds();
   /* Checked after the clock stopped: the checks share the machine with the
    * daemon. */
   for (int k = 0; k < b->count; k++) {
@@ -221,7 +166,7 @@ static double burst(const char *sock, double **xyz, size_t n, int jobs,
   burst_t b[NC];
   atomic_int failed;
   atomic_init(&failed, 0);
-  double t0 = seconds();
+  double t0 = bench_seconds();
   int at = 0;
   for (int i = 0; i < NC; i++) {
     int count = jobs / NC + (i < jobs % NC);
@@ -267,13 +212,13 @@ static double direct_burst(double **xyz, size_t n, int jobs,
   direct_t d = {.xyz = xyz, .n = n, .jobs = jobs};
   atomic_init(&d.next, 0);
   pthread_t *th = calloc(threads, sizeof *th);
-  double t0 = seconds();
+  double t0 = bench_seconds();
   for (unsigned i = 0; i < threads; i++)
     pthread_create(&th[i], NULL, direct_worker, &d);
   for (unsigned i = 0; i < threads; i++)
     pthread_join(th[i], NULL);
   free(th);
-  return seconds() - t0;
+  return bench_seconds() - t0;
 }
 
 typedef struct sampler {
@@ -285,7 +230,7 @@ typedef struct sampler {
 static void *sample_rss(void *arg) {
   sampler_t *s = arg;
   while (!atomic_load(&s->stop)) {
-    uint64_t r = rss_of(s->pid);
+    uint64_t r = bench_rss_of(s->pid);
     if (r > s->peak)
       s->peak = r;
     scdt_sleep_ms(5);
@@ -301,19 +246,19 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
   double base = 0, direct_base = 0;
   double *t = calloc((size_t)repeat, sizeof *t);
   for (unsigned w = 1; w <= wmax; w++) {
-    double c0 = cpu_self();
+    double c0 = bench_cpu_self();
     for (int r = 0; r < repeat; r++)
       t[r] = direct_burst(xyz, n, jobs, w);
-    double direct_cpu = (cpu_self() - c0) / repeat;
-    double dm = median(t, repeat);
+    double direct_cpu = (bench_cpu_self() - c0) / repeat;
+    double dm = bench_median(t, repeat);
     if (w == 1)
       direct_base = dm;
     scdt_daemon_t d;
-    if (start(&d, w) != 0) {
+    if (bench_start(&d, w) != 0) {
       fprintf(stderr, "daemon did not start\n");
       exit(1);
     }
-    uint64_t cold = rss_of(d.pid);
+    uint64_t cold = bench_rss_of(d.pid);
     /* A few small jobs first, one per worker: what a daemon keeps after
      * its first jobs (each thread's stack and malloc arena, libraries'
      * one-time state) is not the burst's. */
@@ -325,29 +270,29 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
     burst(d.sock, warms, 2000, (int)w, &warm_failed);
     free(warms);
     free(warm);
-    scdt_stat_wait(d.sock, "jobs_active", 0, T_MS);
+    scdt_stat_wait(d.sock, "jobs_active", 0, BENCH_T_MS);
     scdt_sleep_ms(1000);
-    uint64_t idle = rss_of(d.pid);
+    uint64_t idle = bench_rss_of(d.pid);
     sampler_t s = {.pid = d.pid, .peak = idle};
     atomic_init(&s.stop, 0);
     pthread_t st;
     pthread_create(&st, NULL, sample_rss, &s);
     int failed = 0;
-    double c1 = cpu_of(d.pid);
+    double c1 = bench_cpu_of(d.pid);
     for (int r = 0; r < repeat; r++) {
       int f = 0;
       t[r] = burst(d.sock, xyz, n, jobs, &f);
       failed += f;
     }
-    double daemon_cpu = (cpu_of(d.pid) - c1) / repeat;
+    double daemon_cpu = (bench_cpu_of(d.pid) - c1) / repeat;
     atomic_store(&s.stop, 1);
     pthread_join(st, NULL);
-    scdt_stat_wait(d.sock, "jobs_active", 0, T_MS);
+    scdt_stat_wait(d.sock, "jobs_active", 0, BENCH_T_MS);
     scdt_sleep_ms(1000);
-    uint64_t after = rss_of(d.pid);
+    uint64_t after = bench_rss_of(d.pid);
     uint64_t held = scdt_stat_fresh(d.sock, "memory_jobs_bytes");
     scdt_daemon_stop(&d);
-    double m = median(t, repeat);
+    double m = bench_median(t, repeat);
     if (w == 1)
       base = m;
     printf("  %u worker%s  %7.3f s  %6.2f jobs/s  speed-up %.2f%s   "
@@ -374,17 +319,39 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
 }
 
 static void usage(void) {
-  printf("Usage: shortcrustd-bench [--daemon PATH] [--points N] [--jobs N] "
-         "[--job-points N]\n"
-         "                         [--workers-max W] [--repeat R]\n"
-         "Defaults: the shortcrustd next to this program, 100000 points, 16 "
-         "jobs of\n20000 points, W = number of cores, R = 3.\n");
+  printf("Usage: shortcrustd-bench [--daemon PATH] [--shortcrust PATH] "
+         "[--points N]\n"
+         "                         [--jobs N] [--job-points N] "
+         "[--workers-max W]\n"
+         "                         [--stream-points N] [--stream-seconds S] "
+         "[--repeat R]\n"
+         "                         [--only latency|throughput|round-trip|"
+         "streaming]\n"
+         "Defaults: shortcrustd and shortcrust next to this program, 100000 "
+         "points, 16 jobs\n"
+         "of 20000 points, W = number of cores, 300000 streamed points over "
+         "12 s, R = 3.\n");
+}
+
+/* The path of a program in this program's directory, or NULL. */
+static const char *beside_self(const char *name, char *buf, size_t len) {
+  ssize_t n = readlink("/proc/self/exe", buf, len - 1);
+  if (n <= 0)
+    return NULL;
+  buf[n] = '\0';
+  char *slash = strrchr(buf, '/');
+  char *at = slash ? slash + 1 : buf;
+  if ((size_t)(at - buf) + strlen(name) + 1 > len)
+    return NULL;
+  strcpy(at, name);
+  return buf;
 }
 
 int main(int argc, char **argv) {
-  static char self_dir[4096];
-  const char *daemon = NULL;
-  size_t points = 100000, job_points = 20000;
+  static char daemon_path[4096], shortcrust_path[4096];
+  const char *daemon = NULL, *shortcrust = NULL, *only = NULL;
+  size_t points = 100000, job_points = 20000, stream_points = 300000;
+  double stream_seconds = 12;
   int jobs = 16, repeat = 3;
   unsigned wmax = (unsigned)sysconf(_SC_NPROCESSORS_ONLN);
   for (int i = 1; i < argc; i++) {
@@ -409,29 +376,46 @@ int main(int argc, char **argv) {
       wmax = (unsigned)atoi(v);
     else if (strcmp(a, "--repeat") == 0)
       repeat = atoi(v);
+    else if (strcmp(a, "--shortcrust") == 0)
+      shortcrust = v;
+    else if (strcmp(a, "--stream-points") == 0)
+      stream_points = (size_t)atol(v);
+    else if (strcmp(a, "--stream-seconds") == 0)
+      stream_seconds = atof(v);
+    else if (strcmp(a, "--only") == 0)
+      only = v;
     else {
       usage();
       return 2;
     }
     i++;
   }
-  if (!daemon) {
-    ssize_t len = readlink("/proc/self/exe", self_dir, sizeof self_dir - 32);
-    if (len <= 0)
-      return 2;
-    self_dir[len] = '\0';
-    char *slash = strrchr(self_dir, '/');
-    strcpy(slash ? slash + 1 : self_dir, "shortcrustd");
-    daemon = self_dir;
-  }
-  if (points < 4 || job_points < 4 || jobs < 1 || repeat < 1 || wmax < 1) {
+  if (!daemon)
+    daemon = beside_self("shortcrustd", daemon_path, sizeof daemon_path);
+  if (!shortcrust)
+    shortcrust =
+        beside_self("shortcrust", shortcrust_path, sizeof shortcrust_path);
+  static const char *const sections[] = {"latency", "throughput", "round-trip",
+                                         "streaming"};
+  int known = !only;
+  for (size_t k = 0; k < sizeof sections / sizeof *sections; k++)
+    known |= only && strcmp(only, sections[k]) == 0;
+  if (!daemon || !shortcrust || !known || points < 4 || job_points < 4 ||
+      stream_points < 4 || !(stream_seconds >= 0) || jobs < 1 || repeat < 1 ||
+      wmax < 1) {
     usage();
     return 2;
   }
   char *fake[] = {argv[0], (char *)daemon, NULL};
   scdt_setup(2, fake);
-  latency(points, repeat);
-  throughput(job_points, jobs, wmax, repeat);
+  if (!only || strcmp(only, "latency") == 0)
+    latency(points, repeat);
+  if (!only || strcmp(only, "throughput") == 0)
+    throughput(job_points, jobs, wmax, repeat);
+  if (!only || strcmp(only, "round-trip") == 0)
+    bench_round_trip(shortcrust, points, repeat);
+  if (!only || strcmp(only, "streaming") == 0)
+    bench_streaming(shortcrust, stream_points, stream_seconds, repeat);
   scdt_cleanup(0);
   return 0;
 }
