@@ -17,7 +17,9 @@
 #include <tbb/task_arena.h>
 #endif
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <numeric>
 
 namespace sc {
@@ -57,6 +59,97 @@ inline int brio_round(uint32_t i) {
   return z == 0 ? kRounds : std::min(kRounds, __builtin_ctzll(z) / 2);
 }
 
+// Where to start looking for a point in a triangulation that already
+// covers its region (a later chunk, in the daemon): a vertex near it. The
+// vertices go into the cells of a uniform grid, about two per occupied
+// cell when they sample a surface, kept in an open-addressing hash table
+// of the occupied cells (16 bytes per vertex at most), one vertex per
+// cell. Without it, each point of a chunk spread over the whole surface
+// walked from the previous one, a few spacings away, through cells no
+// longer in the cache: a chunk of 16k points into 300k inserted at 42 us
+// a point, against 34 with the grid (17 for the points of one sorted
+// insertion).
+template <class Vh> class HintGrid {
+public:
+  template <class DT> void build(const DT &dt) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+           hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    size_t nv = 0;
+    for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end();
+         ++v, ++nv)
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], v->point()[a]);
+        hi[a] = std::max(hi[a], v->point()[a]);
+      }
+    built_for_ = nv;
+    slots_.clear();
+    const double ext = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    if (!(ext > 0) || nv == 0)
+      return;
+    // k^2 cells of the k^3 hold a surface, roughly.
+    k_ = uint64_t(std::clamp(std::sqrt(double(nv) / 2), 1.0, 1e6));
+    inv_ = double(k_) / ext;
+    for (int a = 0; a < 3; ++a)
+      lo_[a] = lo[a];
+    size_t cap = 16;
+    while (cap < 2 * nv)
+      cap *= 2;
+    slots_.assign(cap, Slot{0, Vh()});
+    used_ = 0;
+    for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end();
+         ++v)
+      put(v->point(), v);
+  }
+  size_t built_for() const { return built_for_; }
+  bool empty() const { return slots_.empty(); }
+  // A vertex in the cell of p, or the null handle.
+  template <class P> Vh get(const P &p) const {
+    const Slot *s = find(key(p));
+    return s && s->key ? s->v : Vh();
+  }
+  // Makes v the vertex of the cell of p; a new cell only while the table
+  // is at most half full.
+  template <class P> void put(const P &p, Vh v) {
+    const uint64_t k = key(p);
+    Slot *s = const_cast<Slot *>(find(k));
+    if (s->key == 0) {
+      if (2 * (used_ + 1) > slots_.size())
+        return;
+      ++used_;
+      s->key = k;
+    }
+    s->v = v;
+  }
+
+private:
+  struct Slot {
+    uint64_t key; // the cell's number plus one; 0 for an empty slot
+    Vh v;
+  };
+  template <class P> uint64_t key(const P &p) const {
+    uint64_t c = 0;
+    for (int a = 2; a >= 0; --a) {
+      const double t = (p[a] - lo_[a]) * inv_;
+      const uint64_t i = t < 0 ? 0 : t >= double(k_) ? k_ - 1 : uint64_t(t);
+      c = c * k_ + i;
+    }
+    return c + 1;
+  }
+  // The slot holding key k, or the empty slot where it would go.
+  const Slot *find(uint64_t k) const {
+    const size_t mask = slots_.size() - 1;
+    size_t i = size_t((k * 0x9E3779B97F4A7C15ull) >> 20) & mask;
+    while (slots_[i].key != 0 && slots_[i].key != k)
+      i = (i + 1) & mask;
+    return &slots_[i];
+  }
+
+  std::vector<Slot> slots_;
+  double lo_[3] = {0, 0, 0}, inv_ = 1;
+  uint64_t k_ = 1;
+  size_t used_ = 0, built_for_ = 0;
+};
+
 template <class DT> class TriangulatorImpl : public Triangulator {
 public:
   template <class... A> explicit TriangulatorImpl(A &&...a) : dt_(a...) {}
@@ -76,7 +169,16 @@ public:
     std::iota(order.begin(), order.end(), uint32_t(first));
     hilbert_sort(xyz, order);
     std::vector<uint32_t> brio(n);
-    {
+    // A chunk that comes after at least as many points lands in a
+    // triangulation that already spans its region: there the rounds only
+    // make the walk from one point to the next longer, and the plain
+    // Hilbert order with a hint from the grid is faster (a chunk of 16k
+    // points into 200k: 63 us a point in rounds, 41 without, 34 with the
+    // grid too). The triangulation is the same whatever the order.
+    const bool append = dt_.number_of_vertices() >= std::max<size_t>(n, 1000);
+    if (append) {
+      brio = order;
+    } else {
       // A counting sort by round, the last (largest) round last: bucket
       // kRounds - r, of kRounds + 1, starts at start[kRounds - r].
       std::array<size_t, kRounds + 2> start{};
@@ -94,6 +196,11 @@ public:
     order = {};
     const size_t batch = std::max<size_t>(1u << 14, n / 64);
     Ch hint;
+    // Built again each time the triangulation has grown fourfold.
+    if (append &&
+        (grid_.empty() || dt_.number_of_vertices() > 4 * grid_.built_for()))
+      grid_.build(dt_);
+    const bool use_grid = append && !grid_.empty();
     for (size_t done = 0; done < n; done += batch) {
       progress.report(double(done) / double(n));
       size_t m = std::min(batch, n - done);
@@ -103,9 +210,17 @@ public:
         if (k + 1 < n)
           __builtin_prefetch(xyz + 3 * size_t(brio[k + 1]));
         const double *p = xyz + 3 * size_t(brio[k]);
-        Vh v = dt_.insert(Point(p[0], p[1], p[2]), hint);
+        Point pt(p[0], p[1], p[2]);
+        if (use_grid) {
+          Vh near = grid_.get(pt);
+          if (near != Vh())
+            hint = near->cell();
+        }
+        Vh v = dt_.insert(pt, hint);
         v->info().idx = brio[k];
         hint = v->cell();
+        if (use_grid)
+          grid_.put(pt, v);
       }
     }
     progress.report(1.0);
@@ -240,6 +355,7 @@ private:
   std::vector<uint32_t> hilbert_;
   std::vector<Vh> vh_; // vertex number -> handle, while closing
   std::vector<Ch> infinite_; // from the poles stage to the candidates
+  HintGrid<Vh> grid_;
 };
 
 #ifdef CGAL_LINKED_WITH_TBB
