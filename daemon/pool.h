@@ -66,6 +66,7 @@ struct scd_task {
   int input_ended;
   scd_chunk_t *head, *tail;
   uint64_t pending;   /* points in head..tail */
+  uint64_t first_ns;  /* when the first points came */
   scd_task_t *qprev, *qnext; /* run queue */
   scd_task_t *onext;  /* outbox */
   unsigned events;    /* SCD_EV_*; non-zero exactly while in the outbox */
