@@ -16,6 +16,9 @@
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
+#ifdef CGAL_LINKED_WITH_TBB
+#include <tbb/scalable_allocator.h>
+#endif
 
 extern "C" const char *sc_strerror(int code) {
   switch (code) {
@@ -264,6 +267,17 @@ extern "C" void sc_mesh_free(sc_mesh_t *mesh) {
 
 extern "C" uint64_t sc_estimate_bytes(uint64_t n) {
   return sc::kBytesPerPoint * n + (1u << 20);
+}
+
+extern "C" void sc_release_memory(void) {
+#ifdef CGAL_LINKED_WITH_TBB
+  // CGAL's k-d trees (the noise estimate, the smoothing) keep their nodes
+  // in TBB's scalable allocator, which holds on to freed blocks.
+  (void)scalable_allocation_command(TBBMALLOC_CLEAN_ALL_BUFFERS, nullptr);
+#endif
+#ifdef __GLIBC__
+  (void)malloc_trim(0);
+#endif
 }
 
 extern "C" int sc_tune_allocator(void) {

@@ -540,6 +540,14 @@ uint64_t sc_estimate_bytes(uint64_t n);
  */
 int sc_tune_allocator(void);
 
+/*
+ * Hands back to the system what the allocators keep of the memory that
+ * finished reconstructions freed: the C library's free pages (glibc's
+ * malloc_trim()) and the pools of TBB's allocator, in which CGAL's k-d
+ * trees keep their nodes. For a long-running program, when it is idle.
+ */
+void sc_release_memory(void);
+
 #ifdef __cplusplus
 }
 #endif

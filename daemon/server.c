@@ -16,9 +16,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 
 void scd_config_init(scd_config_t *cfg) {
   memset(cfg, 0, sizeof *cfg);
@@ -61,17 +58,15 @@ void scd_budget_set(scd_server_t *srv, scd_task_t *t, uint64_t bytes) {
   t->reserved = bytes;
 }
 
-/* glibc keeps freed memory in per-thread arenas; hand it back to the system
- * when the daemon has been idle for a moment, so that its size returns to
- * where it was after a burst. The delay keeps the trim (a walk over every
- * arena) off the path of a client that sends one job after another. */
+/* The allocators keep freed memory (glibc in per-thread arenas, TBB's in
+ * its pools); hand it back to the system when the daemon has been idle for
+ * a moment, so that its size returns to where it was after a burst. The
+ * delay keeps the trim (a walk over every arena) off the path of a client
+ * that sends one job after another. */
 static void on_trim(uv_timer_t *h) {
   scd_server_t *srv = h->data;
-  if (srv->tasks_live == 0) {
-#ifdef __GLIBC__
-    malloc_trim(0);
-#endif
-  }
+  if (srv->tasks_live == 0)
+    sc_release_memory();
 }
 
 void scd_server_free_task(scd_server_t *srv, scd_task_t *t) {
