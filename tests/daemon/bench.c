@@ -230,7 +230,7 @@ typedef struct sampler {
 static void *sample_rss(void *arg) {
   sampler_t *s = arg;
   while (!atomic_load(&s->stop)) {
-    uint64_t r = bench_rss_of(s->pid);
+    uint64_t r = scdt_rss(s->pid);
     if (r > s->peak)
       s->peak = r;
     scdt_sleep_ms(5);
@@ -258,7 +258,7 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
       fprintf(stderr, "daemon did not start\n");
       exit(1);
     }
-    uint64_t cold = bench_rss_of(d.pid);
+    uint64_t cold = scdt_rss(d.pid);
     /* A few small jobs first, one per worker: what a daemon keeps after
      * its first jobs (each thread's stack and malloc arena, libraries'
      * one-time state) is not the burst's. */
@@ -272,7 +272,7 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
     free(warm);
     scdt_stat_wait(d.sock, "jobs_active", 0, BENCH_T_MS);
     scdt_sleep_ms(1000);
-    uint64_t idle = bench_rss_of(d.pid);
+    uint64_t idle = scdt_rss(d.pid);
     sampler_t s = {.pid = d.pid, .peak = idle};
     atomic_init(&s.stop, 0);
     pthread_t st;
@@ -289,7 +289,7 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
     pthread_join(st, NULL);
     scdt_stat_wait(d.sock, "jobs_active", 0, BENCH_T_MS);
     scdt_sleep_ms(1000);
-    uint64_t after = bench_rss_of(d.pid);
+    uint64_t after = scdt_rss(d.pid);
     uint64_t held = scdt_stat_fresh(d.sock, "memory_jobs_bytes");
     scdt_daemon_stop(&d);
     double m = bench_median(t, repeat);
@@ -301,9 +301,10 @@ static void throughput(size_t n, int jobs, unsigned wmax, int repeat) {
            w, w == 1 ? " " : "s", m, jobs / m, base / m,
            failed ? "  (FAILED JOBS)" : "", w, w == 1 ? "" : "s", dm,
            direct_base / dm, m / dm);
-    printf("             CPU per burst: daemon %.3f s, in-process %.3f s "
+    printf("             CPU per job: daemon %.1f ms, in-process %.1f ms "
            "(ratio %.3f)\n",
-           daemon_cpu, direct_cpu, direct_cpu > 0 ? daemon_cpu / direct_cpu : 0);
+           1e3 * daemon_cpu / jobs, 1e3 * direct_cpu / jobs,
+           direct_cpu > 0 ? daemon_cpu / direct_cpu : 0);
     printf("             memory: started %.1f MiB, idle after warm-up %.1f "
            "MiB, burst peak %.1f MiB,\n"
            "             after the burst %.1f MiB (ratio after/idle %.2f); "

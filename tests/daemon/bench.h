@@ -19,8 +19,6 @@
 double bench_median(double *v, int n);
 /* Seconds from a monotonic clock. */
 double bench_seconds(void);
-/* Resident size of a process, bytes; 0 when unknown. */
-uint64_t bench_rss_of(pid_t pid);
 /* CPU seconds a process has used (user and system); 0 when unknown. */
 double bench_cpu_of(pid_t pid);
 /* CPU seconds this process has used. */

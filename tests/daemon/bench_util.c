@@ -23,20 +23,6 @@ double bench_median(double *v, int n) {
 
 double bench_seconds(void) { return (double)scdt_now_ms() / 1e3; }
 
-uint64_t bench_rss_of(pid_t pid) {
-  char path[64], line[256];
-  snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
-  FILE *f = fopen(path, "r");
-  if (!f)
-    return 0;
-  uint64_t kb = 0;
-  while (fgets(line, sizeof line, f))
-    if (sscanf(line, "VmRSS: %llu kB", (unsigned long long *)&kb) == 1)
-      break;
-  fclose(f);
-  return kb * 1024;
-}
-
 double bench_cpu_of(pid_t pid) {
   char path[64];
   snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);

@@ -43,6 +43,20 @@ void scdt_setup(int argc, char **argv) {
 
 const char *scdt_daemon_binary(void) { return daemon_path; }
 
+uint64_t scdt_rss(pid_t pid) {
+  char path[64], line[256];
+  snprintf(path, sizeof path, "/proc/%d/status", (int)pid);
+  FILE *f = fopen(path, "r");
+  if (!f)
+    return 0;
+  uint64_t kb = 0;
+  while (fgets(line, sizeof line, f))
+    if (sscanf(line, "VmRSS: %llu kB", (unsigned long long *)&kb) == 1)
+      break;
+  fclose(f);
+  return kb * 1024;
+}
+
 void scdt_sleep_ms(unsigned ms) {
   struct timespec ts = {.tv_sec = ms / 1000, .tv_nsec = (ms % 1000) * 1000000L};
   while (nanosleep(&ts, &ts) != 0 && errno == EINTR)

@@ -81,6 +81,9 @@ uint64_t scdt_stat_fresh(const char *sock, const char *name);
 uint64_t scdt_stat_wait(const char *sock, const char *name, uint64_t want,
                         int timeout_ms);
 
+/* Resident size of a process, bytes (VmRSS); 0 when unknown. */
+uint64_t scdt_rss(pid_t pid);
+
 /* A one-shot sleep. */
 void scdt_sleep_ms(unsigned ms);
 
