@@ -228,6 +228,14 @@ public:
 
   int dimension() const override { return dt_.dimension(); }
 
+  void translate(const double shift[3]) override {
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v) {
+      const Point &p = v->point();
+      v->set_point(Point(p.x() - shift[0], p.y() - shift[1], p.z() - shift[2]));
+    }
+  }
+
   void filter(const double *xyz, size_t n, const sc_params_t &params,
               Progress &progress, Filtered &out, sc_diag_t &diag,
               double seconds[SC_STAGE_COUNT]) override {

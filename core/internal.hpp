@@ -122,7 +122,16 @@ public:
   // Frees the triangulation.
   virtual bool close(std::vector<uint32_t> &tris, Progress &progress,
                      sc_diag_t &diag) = 0;
+  // Moves every vertex by -shift; the caller makes sure each subtraction
+  // is exact (recentre()), so the triangulation stays the Delaunay
+  // triangulation of its points, cell for cell.
+  virtual void translate(const double shift[3]) = 0;
 };
+
+// Section 3.4: sets shift to the lower corner of the points' box on each
+// axis where every coordinate minus it is exact, 0 on the others; returns
+// whether any is not 0.
+bool recentre(const double *xyz, size_t n, double shift[3]);
 
 std::unique_ptr<Triangulator> make_triangulator(int threads,
                                                 const double *bbox6);
@@ -322,6 +331,11 @@ private:
   bool prepared_ = false;
   const double *work_ = nullptr;
   std::vector<double> smoothed_;
+  // The points re-centred (section 3.4) when shift_ is not 0 and they are
+  // not smoothed; whether dt_ holds points in the caller's frame.
+  std::vector<double> shifted_;
+  double shift_[3] = {0, 0, 0};
+  bool dt_raw_ = false;
   NoiseEstimate noise_;
   Smoothing smoothing_;
   double seconds_denoise_ = 0;

@@ -7,6 +7,7 @@
 #include "internal.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -237,8 +238,18 @@ bool Recon::defer_insertion() const { return params_.denoise != 0; }
 void Recon::prepare(Progress &progress) {
   Stopwatch sw;
   prepared_ = true;
-  noise_ = estimate_noise(xyz_, n_, progress);
-  work_ = xyz_;
+  // From here on the points are in the frame of their box's lower corner
+  // where that is exact (section 3.4): the same points moved anywhere give
+  // the same numbers, far from the origin too.
+  const double *base = xyz_;
+  if (recentre(xyz_, n_, shift_)) {
+    shifted_.resize(3 * n_);
+    for (size_t i = 0; i < 3 * n_; ++i)
+      shifted_[i] = xyz_[i] - shift_[i % 3];
+    base = shifted_.data();
+  }
+  noise_ = estimate_noise(base, n_, progress);
+  work_ = base;
   // --denoise smooths at or above the floor (see SC_NOISE_FLOOR) where the
   // sample resolves its surface, or at any noise when given a scale; auto
   // mode likewise without the scale.
@@ -247,9 +258,11 @@ void Recon::prepare(Progress &progress) {
       (params_.mode == SC_MODE_AUTO && noisy)) {
     const double scale = params_.denoise_scale > 0 ? params_.denoise_scale
                                                    : default_scale(noise_);
-    smoothing_ = smooth(xyz_, n_, scale, noise_, progress, smoothed_);
+    smoothing_ = smooth(base, n_, scale, noise_, progress, smoothed_);
     work_ = smoothed_.data();
     dt_.reset(); // the raw points inserted so far
+    dt_raw_ = false;
+    shifted_ = {};
   }
   seconds_denoise_ = sw.lap();
   seconds_[SC_STAGE_INPUT] += seconds_denoise_;
@@ -280,8 +293,10 @@ void Recon::add(const double *xyz, size_t n) {
   size_t first = n_;
   n_ += n;
   seconds_[SC_STAGE_INPUT] += sw.lap();
-  if (!defer_insertion())
+  if (!defer_insertion()) {
     insert_range(xyz_, first, n);
+    dt_raw_ = true;
+  }
 }
 
 void Recon::borrow(const double *xyz, size_t n) {
@@ -411,6 +426,45 @@ sc_mesh_t *mesh_out(const Surface &surf, const std::vector<double> &normals,
 // extraction (the walk, small holes, description), then for scans dropping
 // bubbles, closing (watertight mode) and attaching samples; last the
 // normals and the mesh in input indices.
+namespace {
+
+// The exponent of the lowest set bit of x (x finite and not zero): x is a
+// multiple of 2 to that power.
+int lowest_bit(double x) {
+  int e;
+  const double m = std::frexp(std::fabs(x), &e); // in [0.5, 1)
+  const uint64_t bits = uint64_t(std::ldexp(m, 53));
+  return e - 53 + __builtin_ctzll(bits);
+}
+
+} // namespace
+
+bool recentre(const double *xyz, size_t n, double shift[3]) {
+  bool any = false;
+  for (int a = 0; a < 3; ++a) {
+    shift[a] = 0;
+    if (n == 0)
+      continue;
+    double lo = xyz[a], hi = xyz[a];
+    int low = INT_MAX;
+    for (size_t i = 0; i < n; ++i) {
+      const double c = xyz[3 * i + a];
+      lo = std::min(lo, c);
+      hi = std::max(hi, c);
+      if (c != 0)
+        low = std::min(low, lowest_bit(c));
+    }
+    // Every coordinate and lo are multiples of 2^low, so each difference
+    // is one too; below 2^(low + 53) it is exact. (hi - lo is rounded: one
+    // bit of margin.)
+    if (lo == 0 || low == INT_MAX || !(hi - lo < std::ldexp(1.0, low + 52)))
+      continue;
+    shift[a] = lo;
+    any = true;
+  }
+  return any;
+}
+
 sc_mesh_t *Recon::finish() {
   // However the reconstruction ends, the scratch it kept goes.
   struct ScratchRelease {
@@ -433,13 +487,17 @@ sc_mesh_t *Recon::finish() {
   diag.spacing = noise_.spacing;
   diag.noise = noise_.noise;
   diag.curvature = noise_.curvature;
-  diag.denoised = work_ != xyz_;
+  diag.denoised = !smoothed_.empty();
   diag.denoise_scale = smoothing_.scale;
   diag.denoise_shift = smoothing_.shift;
   diag.seconds_denoise = seconds_denoise_;
   if (!dt_)
     insert_range(work, 0, n_);
   check_spread(n_, dt_.get());
+  // Points inserted as they came are in the caller's frame: moved with
+  // the rest, exactly.
+  if (dt_raw_ && !shifted_.empty())
+    dt_->translate(shift_);
 
   Filtered f;
   const bool watertight = params_.mode == SC_MODE_WATERTIGHT;
@@ -535,8 +593,8 @@ sc_mesh_t *Recon::finish() {
       sc_mesh_free(out);
       throw std::bad_alloc();
     }
-    std::memcpy(out->smoothed, smoothed_.data(),
-                smoothed_.size() * sizeof(double));
+    for (size_t i = 0; i < smoothed_.size(); ++i)
+      out->smoothed[i] = smoothed_[i] + shift_[i % 3];
   }
   return out;
 }
