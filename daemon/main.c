@@ -279,7 +279,8 @@ static void tune_allocator(void) {
   if (mallopt(M_ARENA_MAX, 1) != 1 ||
       mallopt(M_MMAP_THRESHOLD, 32 << 20) != 1 ||
       mallopt(M_TRIM_THRESHOLD, INT_MAX) != 1)
-    scd_log(SCD_LOG_WARN, "the C library refused the allocator settings; "
+    scd_log(SCD_LOG_WARN, "the allocator did not take the settings (a "
+                          "sanitizer's does not); "
                           "jobs run with its defaults");
 #endif
 }
