@@ -190,14 +190,21 @@ static void genus_list(FILE *f, const sc_cli_result_t *r) {
   }
 }
 
+/* A path as the summary and the warnings name it. */
+static const char *shown(const char *path, const char *stdio_name) {
+  return strcmp(path, "-") == 0 ? stdio_name : path;
+}
+
 void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
   const sc_diag_t *d = r->diag;
-  fprintf(f, "%s: %llu points", r->input, (unsigned long long)d->points_in);
+  fprintf(f, "%s: %llu points", shown(r->input, "standard input"),
+          (unsigned long long)d->points_in);
   if (d->duplicates_merged)
     fprintf(f, " (%llu duplicates merged)",
             (unsigned long long)d->duplicates_merged);
-  fprintf(f, " -> %llu triangles in %s, mode %s", (unsigned long long)d->triangles,
-          r->output, sc_mode_name(r->params.mode));
+  fprintf(f, " -> %llu triangles in %s, mode %s",
+          (unsigned long long)d->triangles, shown(r->output, "standard output"),
+          sc_mode_name(r->params.mode));
   if (r->params.mode == SC_MODE_SHORTCRUST)
     fprintf(f, " (r = %g)", r->params.r);
   fprintf(f, ".\n");
@@ -333,11 +340,13 @@ static void warn_sparse(const sc_cli_result_t *r) {
   if (d->triangles == 0)
     sc_cli_error("warning: %s: the mesh is empty: the points support no "
                  "surface that mode %s accepts",
-                 r->output, sc_mode_name(r->params.mode));
+                 shown(r->output, "standard output"),
+                 sc_mode_name(r->params.mode));
   else if (d->mostly_unused || 2 * d->samples_unused > d->delaunay_vertices)
     sc_cli_error("warning: %s: %llu of %llu distinct samples are in no "
                  "triangle",
-                 r->output, (unsigned long long)d->samples_unused,
+                 shown(r->output, "standard output"),
+                 (unsigned long long)d->samples_unused,
                  (unsigned long long)d->delaunay_vertices);
 }
 
@@ -359,8 +368,9 @@ int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
   int status = SC_EXIT_OK;
   if (o->report && sc_cli_write_report(o->report, r) < 0)
     status = SC_EXIT_FAILURE;
+  /* With the mesh on standard output, the summary goes beside it. */
   if (!o->quiet)
-    sc_cli_summary(stdout, r);
+    sc_cli_summary(strcmp(o->out_path, "-") == 0 ? stderr : stdout, r);
   warn_sparse(r);
   return status;
 }

@@ -16,18 +16,23 @@
 #include "shortcrust_files.h"
 
 static void usage(FILE *f) {
-  fputs("usage: shortcrust reconstruct IN -o OUT [options]\n\n"
-        "Reconstructs a triangle mesh from the points of IN and writes it to\n"
-        "OUT. IN may be .ply (ascii or binary), .xyz/.txt/.pts/.csv, .off or\n"
-        ".obj (a mesh file gives its vertices). OUT's extension picks the\n"
-        "format: .ply (binary unless --ascii), .off, .obj or .stl. Every input\n"
-        "point is written, in input order, so triangle indices refer to IN.\n\n"
-        "options:\n",
-        f);
+  fputs(
+      "usage: shortcrust reconstruct IN -o OUT [options]\n\n"
+      "Reconstructs a triangle mesh from the points of IN and writes it to\n"
+      "OUT. IN may be .ply (ascii or binary), .xyz/.txt/.pts/.csv, .off or\n"
+      ".obj (a mesh file gives its vertices). OUT's extension picks the\n"
+      "format: .ply (binary unless --ascii), .off, .obj or .stl. Every input\n"
+      "point is written, in input order, so triangle indices refer to IN.\n"
+      "IN may be - for standard input (PLY, told by its first line, or else\n"
+      "the points of a text file) and OUT - for standard output (PLY; the\n"
+      "summary then goes to stderr).\n\n"
+      "options:\n",
+      f);
   sc_cli_job_usage_params(f, 1);
   sc_cli_job_usage_output(f);
   fputs("Progress goes to stderr when it is a terminal; the summary goes to\n"
-        "stdout. Exit status: 0 done, 1 failed (the message says why), 2 bad\n"
+        "stdout (stderr with -o -). Exit status: 0 done, 1 failed (the message "
+        "says why), 2 bad\n"
         "command line. A mesh that is empty or leaves most samples in no\n"
         "triangle is written with status 0 and a warning line on stderr.\n",
         f);

@@ -20,27 +20,31 @@
 
 static void usage(FILE *f) {
   char sock[256];
-  fputs("usage: shortcrust submit IN -o OUT [options]\n\n"
-        "Sends the points of IN to the shortcrust daemon (shortcrustd), which\n"
-        "reconstructs the mesh, and writes the mesh to OUT. Formats, summary\n"
-        "and report are those of `shortcrust reconstruct`, and so are the\n"
-        "triangles for the same input and options. IN may be .ply (ascii or\n"
-        "binary), .xyz/.txt/.pts/.csv, .off or .obj; OUT's extension picks the\n"
-        "format: .ply (binary unless --ascii), .off, .obj or .stl. The daemon\n"
-        "reconstructs on one thread; options that leave their default are not\n"
-        "sent, and a daemon too old to take the others refuses the job.\n\n"
-        "options:\n",
-        f);
+  fputs(
+      "usage: shortcrust submit IN -o OUT [options]\n\n"
+      "Sends the points of IN to the shortcrust daemon (shortcrustd), which\n"
+      "reconstructs the mesh, and writes the mesh to OUT. Formats, summary\n"
+      "and report are those of `shortcrust reconstruct`, and so are the\n"
+      "triangles for the same input and options. IN may be .ply (ascii or\n"
+      "binary), .xyz/.txt/.pts/.csv, .off or .obj; OUT's extension picks the\n"
+      "format: .ply (binary unless --ascii), .off, .obj or .stl; - is\n"
+      "standard input or output, as for reconstruct. The daemon\n"
+      "reconstructs on one thread; options that leave their default are not\n"
+      "sent, and a daemon too old to take the others refuses the job.\n\n"
+      "options:\n",
+      f);
   sc_cli_job_usage_params(f, 0);
   fprintf(f, "      --socket PATH     the daemon's socket (default %s)\n",
           sc_client_default_socket(sock, sizeof sock));
   sc_cli_job_usage_output(f);
-  fputs("Progress (upload, each stage on the daemon, download) goes to stderr\n"
-        "when it is a terminal; the summary goes to stdout. Exit status: 0\n"
-        "done, 1 failed (the message says why), 2 bad command line. A mesh\n"
-        "that is empty or leaves most samples in no triangle is written with\n"
-        "status 0 and a warning line on stderr.\n",
-        f);
+  fputs(
+      "Progress (upload, each stage on the daemon, download) goes to stderr\n"
+      "when it is a terminal; the summary goes to stdout (stderr with -o -).\n"
+      "Exit status: 0\n"
+      "done, 1 failed (the message says why), 2 bad command line. A mesh\n"
+      "that is empty or leaves most samples in no triangle is written with\n"
+      "status 0 and a warning line on stderr.\n",
+      f);
 }
 
 enum { OPT_SOCKET = SC_CLI_OPT_OWN };

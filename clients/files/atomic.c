@@ -58,6 +58,22 @@ int scf__aout_open(scf__aout_t *o, const char *path, char *msg,
   o->path = path;
   o->msg = msg;
   o->msg_len = msg_len;
+  if (scf__is_stdio(path)) {
+    /* Standard output: written in place (a pipe cannot be renamed over),
+     * through a duplicate that commit closes. */
+    o->path = "standard output";
+    o->fd = fcntl(STDOUT_FILENO, F_DUPFD_CLOEXEC, 0);
+    if (o->fd < 0)
+      return scf__aout_errno(o, "cannot duplicate it");
+    o->fp = fdopen(o->fd, "wb");
+    if (o->fp == NULL) {
+      int rc = scf__aout_errno(o, "fdopen failed");
+      scf__aout_abort(o);
+      return rc;
+    }
+    setvbuf(o->fp, NULL, _IOFBF, (size_t)1 << 20);
+    return 0;
+  }
   const char *slash = strrchr(path, '/');
   const char *base = slash ? slash + 1 : path;
   size_t dirlen = (size_t)(base - path);
@@ -103,6 +119,12 @@ int scf__aout_open(scf__aout_t *o, const char *path, char *msg,
 int scf__aout_commit(scf__aout_t *o) {
   if (fflush(o->fp) != 0 || ferror(o->fp))
     return scf__aout_errno(o, "write failed");
+  if (o->tmp == NULL) { /* standard output */
+    FILE *fp = o->fp;
+    o->fp = NULL;
+    o->fd = -1;
+    return fclose(fp) != 0 ? scf__aout_errno(o, "close failed") : 0;
+  }
   if (fsync(o->fd) != 0)
     return scf__aout_errno(o, "fsync failed");
   FILE *fp = o->fp;

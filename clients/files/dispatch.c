@@ -25,6 +25,8 @@ static void path_ext(const char *path, char ext[8]) {
 }
 
 static enum scf__kind kind_of(const char *path) {
+  if (scf__is_stdio(path))
+    return SCF__K_STDIO;
   char ext[8];
   path_ext(path, ext);
   static const struct {
@@ -87,6 +89,22 @@ static int read_any(const char *path, scf_points_t *pts, uint32_t **tri,
   scf__tbuf_t t = {NULL, 0, 0};
   scf__tbuf_t *tp = mesh ? &t : NULL;
   int rc = scf__rd_open(&r, path, msg, msg_len);
+  if (rc == 0 && kind == SCF__K_STDIO) {
+    /* Standard input has no name to tell its format: PLY by its magic
+     * word, else the points of a text file. */
+    r.path = "standard input";
+    while (rc == 0 && r.end - r.pos < 4 && !r.eof)
+      rc = scf__rd_fill(&r);
+    const unsigned char *b = r.buf + r.pos;
+    const size_t have = r.end - r.pos;
+    kind =
+        have >= 4 && memcmp(b, "ply", 3) == 0 && (b[3] == '\n' || b[3] == '\r')
+            ? SCF__K_PLY
+            : SCF__K_XYZ;
+    if (rc == 0 && mesh && kind != SCF__K_PLY)
+      rc = scf__fail(msg, msg_len, SCF_EUNSUPPORTED, r.path,
+                     "a mesh must come as PLY");
+  }
   if (rc == 0) {
     switch (kind) {
     case SCF__K_PLY:
@@ -157,6 +175,7 @@ int scf_mesh_format_from_path(const char *path, int ascii,
   if (path == NULL || fmt == NULL)
     return scf__fail(msg, msg_len, SCF_EINVAL, path, "NULL argument");
   switch (kind_of(path)) {
+  case SCF__K_STDIO: /* standard output: PLY */
   case SCF__K_PLY:
     *fmt = ascii ? SCF_MESH_FMT_PLY_ASCII : SCF_MESH_FMT_PLY_BINARY;
     return 0;

@@ -47,7 +47,9 @@ int scf__rd_open(scf__rd_t *r, const char *path, char *msg, size_t msg_len) {
   r->msg = msg;
   r->msg_len = msg_len;
   r->size = UINT64_MAX;
-  r->fd = open(path, O_RDONLY | O_CLOEXEC);
+  /* A duplicate, so that closing the reader leaves standard input open. */
+  r->fd = scf__is_stdio(path) ? fcntl(STDIN_FILENO, F_DUPFD_CLOEXEC, 0)
+                              : open(path, O_RDONLY | O_CLOEXEC);
   if (r->fd < 0) {
     int e = errno;
     return scf__fail(msg, msg_len, e == ENOENT ? SCF_ENOENT : SCF_EIO, path,

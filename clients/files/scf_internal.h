@@ -59,8 +59,14 @@ enum scf__kind {
   SCF__K_PTS,
   SCF__K_OFF,
   SCF__K_OBJ,
-  SCF__K_STL
+  SCF__K_STL,
+  SCF__K_STDIO /* "-": standard input (PLY or XYZ, by PLY's magic) or output */
 };
+
+/* "-" names standard input or standard output. */
+static inline int scf__is_stdio(const char *path) {
+  return path != NULL && path[0] == '-' && path[1] == '\0';
+}
 
 /*
  * The buffered reader (reader.c). The buffer holds one byte more than

@@ -79,6 +79,8 @@ typedef struct scf_points {
  *                             skipped.
  *   .off                      OFF (also COFF, NOFF, CNOFF, STOFF): vertices.
  *   .obj                      Wavefront OBJ: the 'v' lines.
+ *   -                         standard input: PLY when it starts with the
+ *                             line "ply", else .xyz text.
  * PLY and OFF files must start with their magic word. A non-finite number
  * ("nan", "inf") is returned as it is; a token that is not a number is an
  * error. A file without points is not an error: count is 0 and xyz NULL.
@@ -120,9 +122,9 @@ typedef enum scf_mesh_format {
 
 /*
  * The output format for a path's extension: .ply, .off, .obj or .stl (any
- * case). With ascii non-zero, .ply and .stl give their ascii variant; OFF
- * and OBJ are text in any case. Returns 0, or SCF_EUNSUPPORTED with a
- * message naming the extension.
+ * case), or PLY for "-" (standard output). With ascii non-zero, .ply and
+ * .stl give their ascii variant; OFF and OBJ are text in any case. Returns 0,
+ * or SCF_EUNSUPPORTED with a message naming the extension.
  */
 int scf_mesh_format_from_path(const char *path, int ascii,
                               scf_mesh_format_t *fmt, char *msg,
@@ -130,7 +132,9 @@ int scf_mesh_format_from_path(const char *path, int ascii,
 
 /*
  * Writes n_points vertices (xyz, 3 * n_points doubles) and n_tri triangles
- * (tri, 3 * n_tri indices into the vertices) to path, atomically.
+ * (tri, 3 * n_tri indices into the vertices) to path, atomically; "-" is
+ * standard output, written in place (what a failure leaves there is
+ * partial).
  *
  * Every point is written, used by a triangle or not, so that indices keep
  * their meaning. Coordinates are written exactly: as doubles in binary PLY

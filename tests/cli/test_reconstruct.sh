@@ -35,6 +35,31 @@ expect 0 "genus 1" "$sc" reconstruct "$knot" -o "$tmp/knot.stl"
 tris=$("$info" "$tmp/knot.ply" | sed 's/.*triangles=\([0-9]*\).*/\1/')
 "$info" "$tmp/knot.stl" | grep -q "triangles=$tris " || fail "STL triangle count"
 
+# - is standard input and output: PLY or, failing its magic, the points of
+# a text file in; PLY out, byte for byte what the file would hold, with the
+# summary on stderr; errors name the stream and leave status 1.
+"$sc" reconstruct "$knot" -o "$tmp/file.ply" -q || fail "reconstruct to a file"
+"$sc" reconstruct "$knot" -o "$tmp/knot.obj" -q || fail "reconstruct to OBJ"
+grep '^v ' "$tmp/knot.obj" | cut -c3- > "$tmp/knot.xyz"
+"$sc" reconstruct - -o - < "$knot" > "$tmp/piped.ply" 2> "$tmp/err" ||
+  fail "reconstruct - -o -: $(cat "$tmp/err")"
+cmp -s "$tmp/piped.ply" "$tmp/file.ply" || fail "PLY through a pipe differs"
+grep -q "standard input: 3200 points -> 6400 triangles in standard output" \
+  "$tmp/err" || fail "summary on stderr: $(cat "$tmp/err")"
+cat "$tmp/knot.xyz" | "$sc" reconstruct - -o - -q > "$tmp/piped2.ply" ||
+  fail "text through a pipe"
+cmp -s "$tmp/piped2.ply" "$tmp/file.ply" || fail "text through a pipe differs"
+printf 'ply\nformat ascii 1.0\nelement vertex 1\n' > "$tmp/cut.ply"
+expect 1 "standard input: line 3: file ends inside the header" \
+  sh -c '"$1" reconstruct - -o "$2" < "$3"' sh "$sc" "$tmp/never.ply" "$tmp/cut.ply"
+[ -e "$tmp/never.ply" ] && fail "a failed read wrote its output"
+expect 1 "standard input: line 1: expected 3 numbers" \
+  sh -c 'echo "1 2" | "$1" reconstruct - -o "$2"' sh "$sc" "$tmp/never.ply"
+if [ -w /dev/full ]; then
+  expect 1 "standard output: write failed" \
+    sh -c '"$1" reconstruct "$2" -o - -q > /dev/full' sh "$sc" "$knot"
+fi
+
 # The report is JSON with the diagnostics; --quiet prints nothing.
 expect 0 "" "$sc" reconstruct "$knot" -o "$tmp/q.ply" --quiet --report "$tmp/r.json"
 [ -s "$tmp/out" ] && fail "--quiet printed: $(cat "$tmp/out")"
@@ -128,7 +153,7 @@ expect 1 "collinear" "$sc" reconstruct "$tmp/line.xyz" -o "$tmp/old.ply"
 printf 'ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0\n' > "$tmp/trunc.ply"
 expect 1 "trunc.ply" "$sc" reconstruct "$tmp/trunc.ply" -o "$tmp/old.ply"
 [ "$(cat "$tmp/old.ply")" = keep ] || fail "a failed run replaced the old output"
-ls "$tmp" | grep -q -v -E '^(old.ply|out|err|nan.xyz|line.xyz|trunc.ply|knot\..*|q.ply|r.json|s.ply|t.ply|b.ply|d.ply|d1.ply|d2.ply|dn.json|noisy.xyz|f1|f2|v1|v2)$' &&
+ls "$tmp" | grep -q -v -E '^(old.ply|out|err|nan.xyz|line.xyz|trunc.ply|knot\..*|q.ply|r.json|s.ply|t.ply|b.ply|d.ply|d1.ply|d2.ply|dn.json|noisy.xyz|f1|f2|v1|v2|file.ply|piped.ply|piped2.ply|cut.ply)$' &&
   fail "temporary files left: $(ls "$tmp")"
 
 [ "$fails" -eq 0 ] && echo "all passed"

@@ -137,6 +137,13 @@ expect 0 '"jobs_done_total": ' "$sc" stats --socket "$sock" --json
 grep -q '^{"socket": ".*"connections": [0-9]*.*}$' "$tmp/out" || fail "stats --json: $(cat "$tmp/out")"
 grep -q '"jobs_failed_total": 2[,}]' "$tmp/out" || fail "stats --json: two jobs failed: $(cat "$tmp/out")"
 
+# Standard input and output, as for reconstruct: the same bytes as a file.
+"$sc" reconstruct "$data/knot1_points.ply" -o "$tmp/file.ply" -q || fail "reconstruct to a file"
+"$sc" submit - -o - --socket "$sock" < "$data/knot1_points.ply" > "$tmp/piped.ply" 2> "$tmp/err" ||
+  fail "submit - -o -: $(cat "$tmp/err")"
+cmp -s "$tmp/piped.ply" "$tmp/file.ply" || fail "submit through a pipe differs"
+grep -q "standard input: 3200 points" "$tmp/err" || fail "submit summary on stderr: $(cat "$tmp/err")"
+
 stop_daemon
 [ "$fails" -eq 0 ] || { echo "$fails check(s) failed" >&2; cat "$tmp/daemon.log" >&2; exit 1; }
 echo "all submit, stats and ping checks passed"
