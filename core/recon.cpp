@@ -419,15 +419,6 @@ sc_mesh_t *mesh_out(const Surface &surf, const std::vector<double> &normals,
   return out;
 }
 
-} // namespace
-
-// The stages after insertion, in order: the triangulation's (duplicates,
-// poles, boundary detection, candidates: Triangulator::filter()), pruning,
-// extraction (the walk, small holes, description), then for scans dropping
-// bubbles, closing (watertight mode) and attaching samples; last the
-// normals and the mesh in input indices.
-namespace {
-
 // The exponent of the lowest set bit of x (x finite and not zero): x is a
 // multiple of 2 to that power.
 int lowest_bit(double x) {
@@ -465,6 +456,11 @@ bool recentre(const double *xyz, size_t n, double shift[3]) {
   return any;
 }
 
+// The stages after insertion, in order: the triangulation's (duplicates,
+// poles, boundary detection, candidates: Triangulator::filter()), pruning,
+// extraction (the walk, small holes, description), then for scans dropping
+// bubbles, closing (watertight mode) and attaching samples; last the
+// normals and the mesh in input indices.
 sc_mesh_t *Recon::finish() {
   // However the reconstruction ends, the scratch it kept goes.
   struct ScratchRelease {
