@@ -234,6 +234,7 @@ public:
       const Point &p = v->point();
       v->set_point(Point(p.x() - shift[0], p.y() - shift[1], p.z() - shift[2]));
     }
+    grid_ = HintGrid<Vh>(); // its cells are where the points were
   }
 
   void filter(const double *xyz, size_t n, const sc_params_t &params,
