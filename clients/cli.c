@@ -34,12 +34,15 @@ void sc_cli_job_init(sc_cli_job_opts_t *o) {
 }
 
 void sc_cli_job_usage_output(FILE *f) {
-  fputs("      --report FILE     write the diagnostics as JSON to FILE\n"
-        "      --ascii           write ascii PLY or STL instead of binary\n"
-        "      --no-normals      do not write per-vertex normals\n"
-        "  -q, --quiet           no progress and no summary; errors only\n"
-        "  -h, --help            this text\n\n",
-        f);
+  fputs(
+      "      --report FILE     write the diagnostics as JSON to FILE\n"
+      "      --ascii           write ascii PLY or STL instead of binary\n"
+      "      --no-normals      do not write the computed per-vertex normals\n"
+      "      --mesh-normals    write the computed normals even where the\n"
+      "                        input has its own (nx, ny, nz), in their place\n"
+      "  -q, --quiet           no progress and no summary; errors only\n"
+      "  -h, --help            this text\n\n",
+      f);
 }
 
 int sc_cli_bad_option(const char *cmd, int c, char **argv) {
@@ -311,7 +314,8 @@ int sc_cli_write_report(const char *path, const sc_cli_result_t *r) {
 
 int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
                     scf_mesh_format_t *fmt, scf_points_t *pts,
-                    double *seconds_read) {
+                    scf_attrs_t *attrs, double *seconds_read) {
+  memset(attrs, 0, sizeof *attrs);
   char msg[1024];
   if (scf_mesh_format_from_path(o->out_path, o->ascii, fmt, msg, sizeof msg) <
       0) {
@@ -321,7 +325,7 @@ int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
   sc_cli_progress_init(progress, o->quiet);
   double t0 = sc_cli_now();
   sc_cli_progress_step(progress, "reading", 0);
-  if (scf_points_read(o->in_path, pts, msg, sizeof msg) < 0) {
+  if (scf_points_read_attrs(o->in_path, pts, attrs, msg, sizeof msg) < 0) {
     sc_cli_progress_done(progress);
     sc_cli_error("%s", msg);
     return SC_EXIT_FAILURE;
@@ -352,13 +356,20 @@ static void warn_sparse(const sc_cli_result_t *r) {
 
 int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
                      scf_mesh_format_t fmt, const scf_points_t *pts,
-                     const uint32_t *tris, size_t ntri,
+                     scf_attrs_t *attrs, const uint32_t *tris, size_t ntri,
                      const double *normals, sc_cli_result_t *r) {
   char msg[1024];
   sc_cli_progress_step(progress, "writing", 0);
   double t0 = sc_cli_now();
-  int rc = scf_mesh_write(o->out_path, fmt, pts->xyz, pts->count, tris, ntri,
-                         o->normals ? normals : NULL, msg, sizeof msg);
+  /* The input's own normals stay unless --mesh-normals asks for ours. */
+  if (o->mesh_normals && o->normals && normals != NULL) {
+    scf_attrs_remove(attrs, "nx");
+    scf_attrs_remove(attrs, "ny");
+    scf_attrs_remove(attrs, "nz");
+  }
+  int rc =
+      scf_mesh_write_attrs(o->out_path, fmt, pts->xyz, pts->count, tris, ntri,
+                           o->normals ? normals : NULL, attrs, msg, sizeof msg);
   r->seconds_write = sc_cli_now() - t0;
   sc_cli_progress_done(progress);
   if (rc < 0) {

@@ -39,7 +39,8 @@ int sc_cli_parse_int(const char *opt, const char *arg, long min, long max,
 /*
  * The options every mesh-producing subcommand takes: -o, one per parameter
  * of the core's table (SC_PARAM_MAP in shortcrust.h; those the daemon does
- * not take only where local is 1), --report, --ascii, --no-normals, -q.
+ * not take only where local is 1), --report, --ascii, --no-normals,
+ * --mesh-normals, -q.
  * A subcommand builds its getopt_long tables with sc_cli_job_getopt(),
  * adding its own options (numbered from SC_CLI_OPT_OWN, or short letters),
  * and passes each getopt_long result to sc_cli_job_option() first.
@@ -47,14 +48,15 @@ int sc_cli_parse_int(const char *opt, const char *arg, long min, long max,
 typedef struct sc_cli_job_opts {
   sc_params_t params;
   const char *in_path, *out_path, *report;
-  int quiet, ascii, normals;
+  int quiet, ascii, normals, mesh_normals;
 } sc_cli_job_opts_t;
 
 enum {
   SC_CLI_OPT_REPORT = 256,
   SC_CLI_OPT_ASCII,
   SC_CLI_OPT_NO_NORMALS,
-  SC_CLI_OPT_PARAM,            /* + the row of the parameter table */
+  SC_CLI_OPT_MESH_NORMALS,
+  SC_CLI_OPT_PARAM, /* + the row of the parameter table */
   SC_CLI_OPT_OWN = SC_CLI_OPT_PARAM + 64
 };
 
@@ -144,17 +146,20 @@ int sc_cli_write_report(const char *path, const sc_cli_result_t *r);
 /*
  * The two ends of a mesh-producing job. sc_cli_job_read() checks that -o
  * names a mesh format (SC_EXIT_USAGE otherwise), starts the progress line
- * and reads the input (SC_EXIT_FAILURE, after the message, when it cannot);
- * on SC_EXIT_OK the caller frees pts. sc_cli_job_write() writes the mesh to
+ * and reads the input with its per-point properties (SC_EXIT_FAILURE, after
+ * the message, when it cannot); on SC_EXIT_OK the caller frees pts and
+ * attrs. sc_cli_job_write() writes the mesh to
  * -o, fills r->seconds_write, clears the progress line, then writes the
  * report and prints the summary; it returns the exit status.
  */
 int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
                     scf_mesh_format_t *fmt, scf_points_t *pts,
-                    double *seconds_read);
+                    scf_attrs_t *attrs, double *seconds_read);
+/* The input's properties go on the vertices (attrs is changed: with
+ * --mesh-normals its nx, ny, nz are dropped for the computed normals). */
 int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
                      scf_mesh_format_t fmt, const scf_points_t *pts,
-                     const uint32_t *tris, size_t ntri, const double *normals,
-                     sc_cli_result_t *r);
+                     scf_attrs_t *attrs, const uint32_t *tris, size_t ntri,
+                     const double *normals, sc_cli_result_t *r);
 
 #endif /* SC_CLI_H */

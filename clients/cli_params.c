@@ -22,6 +22,7 @@ static const struct option output_options[] = {
     {"report", required_argument, NULL, SC_CLI_OPT_REPORT},
     {"ascii", no_argument, NULL, SC_CLI_OPT_ASCII},
     {"no-normals", no_argument, NULL, SC_CLI_OPT_NO_NORMALS},
+    {"mesh-normals", no_argument, NULL, SC_CLI_OPT_MESH_NORMALS},
     {"quiet", no_argument, NULL, 'q'},
 };
 enum { NOUTPUT = sizeof output_options / sizeof output_options[0] };
@@ -213,6 +214,9 @@ int sc_cli_job_option(sc_cli_job_opts_t *o, int c, const char *arg) {
     return 1;
   case SC_CLI_OPT_ASCII:
     o->ascii = 1;
+    return 1;
+  case SC_CLI_OPT_MESH_NORMALS:
+    o->mesh_normals = 1;
     return 1;
   case SC_CLI_OPT_NO_NORMALS:
     o->normals = 0;

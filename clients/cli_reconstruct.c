@@ -20,7 +20,9 @@ static void usage(FILE *f) {
       "usage: shortcrust reconstruct IN -o OUT [options]\n\n"
       "Reconstructs a triangle mesh from the points of IN and writes it to\n"
       "OUT. IN may be .ply (ascii or binary), .xyz/.txt/.pts/.csv, .off or\n"
-      ".obj (a mesh file gives its vertices). OUT's extension picks the\n"
+      ".obj (a mesh file gives its vertices); a PLY input's other vertex\n"
+      "properties (colours, normals, ...) go unchanged onto the mesh's\n"
+      "vertices in PLY, colours in OBJ. OUT's extension picks the\n"
       "format: .ply (binary unless --ascii), .off, .obj or .stl. Every input\n"
       "point is written, in input order, so triangle indices refer to IN.\n"
       "IN may be - for standard input (PLY, told by its first line, or else\n"
@@ -77,10 +79,11 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   sc_cli_progress_t progress;
   scf_mesh_format_t fmt;
   scf_points_t pts;
+  scf_attrs_t attrs;
   double t_read;
   /* A hint, before the first large allocation; see shortcrust.h. */
   (void)sc_tune_allocator();
-  int status = sc_cli_job_read(&o, &progress, &fmt, &pts, &t_read);
+  int status = sc_cli_job_read(&o, &progress, &fmt, &pts, &attrs, &t_read);
   if (status != SC_EXIT_OK)
     return status;
   params->progress = sc_cli_progress_fn;
@@ -92,6 +95,7 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   if (rc < 0) {
     sc_cli_progress_done(&progress);
     scf_points_free(&pts);
+    scf_attrs_free(&attrs);
     /* A parameter out of range is the command line's fault, not the file's. */
     if (rc == SC_EINVALID_ARGUMENT) {
       sc_cli_error("reconstruct: %s", msg);
@@ -114,9 +118,10 @@ int sc_cmd_reconstruct(int argc, char **argv) {
   /* --smoothed-vertices: the mesh over the smoothed positions. */
   if (mesh->smoothed)
     memcpy(pts.xyz, mesh->smoothed, 3 * pts.count * sizeof *pts.xyz);
-  status = sc_cli_job_write(&o, &progress, fmt, &pts, mesh->triangles,
+  status = sc_cli_job_write(&o, &progress, fmt, &pts, &attrs, mesh->triangles,
                             mesh->triangle_count, mesh->normals, &res);
   sc_mesh_free(mesh);
   scf_points_free(&pts);
+  scf_attrs_free(&attrs);
   return status;
 }

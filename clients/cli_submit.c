@@ -181,8 +181,9 @@ int sc_cmd_submit(int argc, char **argv) {
   sc_cli_progress_t progress;
   scf_mesh_format_t fmt;
   scf_points_t pts;
+  scf_attrs_t attrs;
   double t_read;
-  int status = sc_cli_job_read(&o, &progress, &fmt, &pts, &t_read);
+  int status = sc_cli_job_read(&o, &progress, &fmt, &pts, &attrs, &t_read);
   if (status != SC_EXIT_OK)
     return status;
 
@@ -195,6 +196,7 @@ int sc_cmd_submit(int argc, char **argv) {
   if (rc < 0) {
     sc_cli_progress_done(&progress);
     scf_points_free(&pts);
+    scf_attrs_free(&attrs);
     sc_cli_error("%s", msg);
     return SC_EXIT_FAILURE;
   }
@@ -243,6 +245,7 @@ int sc_cmd_submit(int argc, char **argv) {
     sc_client_job_free(job);
     sc_client_free(client);
     scf_points_free(&pts);
+    scf_attrs_free(&attrs);
     return status;
   }
 
@@ -266,10 +269,11 @@ int sc_cmd_submit(int argc, char **argv) {
    * as `reconstruct` writes it; none came when nothing was smoothed. */
   if (mesh.vertices)
     memcpy(pts.xyz, mesh.vertices, 3 * pts.count * sizeof *pts.xyz);
-  status = sc_cli_job_write(&o, &progress, fmt, &pts, mesh.triangles,
+  status = sc_cli_job_write(&o, &progress, fmt, &pts, &attrs, mesh.triangles,
                             (size_t)mesh.triangle_count, mesh.normals, &res);
   sc_client_job_free(job);
   sc_client_free(client);
   scf_points_free(&pts);
+  scf_attrs_free(&attrs);
   return status;
 }

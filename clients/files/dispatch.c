@@ -62,7 +62,8 @@ static void *shrink(void *p, size_t bytes) {
 }
 
 static int read_any(const char *path, scf_points_t *pts, uint32_t **tri,
-                    size_t *n_tri, char *msg, size_t msg_len) {
+                    size_t *n_tri, scf_attrs_t *attrs, char *msg,
+                    size_t msg_len) {
   if (msg != NULL && msg_len > 0)
     msg[0] = '\0';
   if (pts != NULL)
@@ -85,7 +86,9 @@ static int read_any(const char *path, scf_points_t *pts, uint32_t **tri,
                                   : ".ply, .xyz, .txt, .pts, .csv, .off or "
                                     ".obj");
   scf__rd_t r;
-  scf__vbuf_t v = {NULL, 0, 0};
+  if (attrs != NULL)
+    memset(attrs, 0, sizeof *attrs);
+  scf__vbuf_t v = {NULL, 0, 0, attrs, 0};
   scf__tbuf_t t = {NULL, 0, 0};
   scf__tbuf_t *tp = mesh ? &t : NULL;
   int rc = scf__rd_open(&r, path, msg, msg_len);
@@ -128,8 +131,11 @@ static int read_any(const char *path, scf_points_t *pts, uint32_t **tri,
   if (rc < 0) {
     free(v.xyz);
     free(t.idx);
+    scf_attrs_free(attrs);
     return rc;
   }
+  if (attrs != NULL && attrs->count == 0)
+    scf_attrs_free(attrs);
   pts->xyz = v.count ? shrink(v.xyz, v.count * 3 * sizeof(double)) : NULL;
   if (v.count == 0)
     free(v.xyz);
@@ -145,7 +151,14 @@ static int read_any(const char *path, scf_points_t *pts, uint32_t **tri,
 
 int scf_points_read(const char *path, scf_points_t *out, char *msg,
                     size_t msg_len) {
-  return read_any(path, out, NULL, NULL, msg, msg_len);
+  return read_any(path, out, NULL, NULL, NULL, msg, msg_len);
+}
+
+int scf_points_read_attrs(const char *path, scf_points_t *out,
+                          scf_attrs_t *attrs, char *msg, size_t msg_len) {
+  if (attrs == NULL)
+    return scf__fail(msg, msg_len, SCF_EINVAL, path, "NULL attrs argument");
+  return read_any(path, out, NULL, NULL, attrs, msg, msg_len);
 }
 
 int scf_mesh_read(const char *path, scf_points_t *pts, uint32_t **tri,
@@ -158,7 +171,7 @@ int scf_mesh_read(const char *path, scf_points_t *pts, uint32_t **tri,
       *tri = NULL;
     return scf__fail(msg, msg_len, SCF_EINVAL, path, "NULL n_tri argument");
   }
-  return read_any(path, pts, tri, n_tri, msg, msg_len);
+  return read_any(path, pts, tri, n_tri, NULL, msg, msg_len);
 }
 
 void scf_points_free(scf_points_t *p) {
@@ -196,6 +209,15 @@ int scf_mesh_format_from_path(const char *path, int ascii,
 int scf_mesh_write(const char *path, scf_mesh_format_t fmt, const double *xyz,
                    size_t n_points, const uint32_t *tri, size_t n_tri,
                    const double *normals, char *msg, size_t msg_len) {
+  return scf_mesh_write_attrs(path, fmt, xyz, n_points, tri, n_tri, normals,
+                              NULL, msg, msg_len);
+}
+
+int scf_mesh_write_attrs(const char *path, scf_mesh_format_t fmt,
+                         const double *xyz, size_t n_points,
+                         const uint32_t *tri, size_t n_tri,
+                         const double *normals, const scf_attrs_t *attrs,
+                         char *msg, size_t msg_len) {
   if (msg != NULL && msg_len > 0)
     msg[0] = '\0';
   if (path == NULL || (xyz == NULL && n_points > 0) ||
@@ -220,7 +242,13 @@ int scf_mesh_write(const char *path, scf_mesh_format_t fmt, const double *xyz,
     return scf__fail(msg, msg_len, SCF_EUNSUPPORTED, path,
                      "binary STL holds at most 2^32 - 1 triangles, not %zu",
                      n_tri);
-  scf__mesh_in_t m = {xyz, n_points, tri, n_tri, normals};
+  if (attrs != NULL && attrs->count == 0)
+    attrs = NULL;
+  if (attrs != NULL && attrs->points != n_points)
+    return scf__fail(msg, msg_len, SCF_EINVAL, path,
+                     "properties for %zu points, but there are %zu points",
+                     attrs->points, n_points);
+  scf__mesh_in_t m = {xyz, n_points, tri, n_tri, normals, attrs};
   scf__aout_t o;
   int rc = scf__aout_open(&o, path, msg, msg_len);
   if (rc < 0)

@@ -80,11 +80,61 @@ int scf__read_obj(scf__rd_t *r, scf__vbuf_t *v, scf__tbuf_t *t) {
   return 0;
 }
 
+/* A colour channel of the record scaled to [0, 1]: integers by their
+ * type's largest value, floats as they are. */
+static double obj_channel(const unsigned char *b, scf_type_t t) {
+  uint64_t u = 0;
+  for (size_t i = 0; i < scf_type_size(t); i++)
+    u |= (uint64_t)b[i] << (8 * i);
+  switch (t) {
+  case SCF_TYPE_UINT8:
+    return (double)u / 255.0;
+  case SCF_TYPE_UINT16:
+    return (double)u / 65535.0;
+  case SCF_TYPE_INT8:
+    return (double)(int8_t)u / 127.0;
+  case SCF_TYPE_INT16:
+    return (double)(int16_t)u / 32767.0;
+  case SCF_TYPE_INT32:
+    return (double)(int32_t)u / 2147483647.0;
+  case SCF_TYPE_UINT32:
+    return (double)u / 4294967295.0;
+  case SCF_TYPE_FLOAT32: {
+    uint32_t w = (uint32_t)u;
+    float f;
+    memcpy(&f, &w, sizeof f);
+    return f;
+  }
+  case SCF_TYPE_FLOAT64: {
+    double d;
+    memcpy(&d, &u, sizeof d);
+    return d;
+  }
+  }
+  return 0;
+}
+
 int scf__write_obj(scf__aout_t *o, const scf__mesh_in_t *m) {
   int rc = scf__out_printf(o, "# written by shortcrust\n");
+  /* Vertex colours, the common `v x y z r g b` extension, when the points
+   * have red, green and blue. */
+  const scf_attrs_t *at = m->attrs;
+  const int cr = scf_attrs_find(at, "red"), cg = scf_attrs_find(at, "green"),
+            cb = scf_attrs_find(at, "blue");
+  const int colours = cr >= 0 && cg >= 0 && cb >= 0;
   for (size_t i = 0; rc == 0 && i < m->n; i++) {
     const double *p = m->xyz + 3 * i;
-    rc = scf__out_printf(o, "v %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+    rc = scf__out_printf(o, "v %.17g %.17g %.17g", p[0], p[1], p[2]);
+    if (rc == 0 && colours) {
+      const unsigned char *ar = at->data + i * at->stride;
+      rc = scf__out_printf(
+          o, " %.9g %.9g %.9g",
+          obj_channel(ar + at->props[cr].offset, at->props[cr].type),
+          obj_channel(ar + at->props[cg].offset, at->props[cg].type),
+          obj_channel(ar + at->props[cb].offset, at->props[cb].type));
+    }
+    if (rc == 0)
+      rc = scf__out_write(o, "\n", 1);
   }
   for (size_t i = 0; rc == 0 && m->normals != NULL && i < m->n; i++) {
     const double *q = m->normals + 3 * i;

@@ -1,8 +1,9 @@
 /*
  * PLY: reading ascii and binary files of either byte order (the x, y, z
- * properties of the "vertex" element and the index list of the "face"
- * element; everything else is skipped), and writing ascii or binary
- * little-endian files.
+ * properties of the "vertex" element, its other scalar properties when
+ * asked for, and the index list of the "face" element; everything else is
+ * skipped), and writing ascii or binary little-endian files, with the
+ * properties read.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -127,9 +128,45 @@ typedef struct ply {
   int px, py, pz;      /* property indices in the vertex element */
   int pface;           /* the index list in the face element */
   uint64_t header_end; /* line number of end_header */
+  int *amap; /* per vertex property: its index in the attributes, or -1 */
 } ply_t;
 
+/* The types are numbered alike in both enums. */
+static scf_type_t ply_scf_type(ply_type_t t) { return (scf_type_t)t; }
+
+/* Stores a value of type t, read from a file of the given byte order, in
+ * an attribute record (little-endian). */
+static void ply_put_attr(unsigned char *dst, const unsigned char *src,
+                         ply_type_t t, int big_endian) {
+  size_t sz = ply_type_size(t);
+  for (size_t i = 0; i < sz; i++)
+    dst[i] = big_endian ? src[sz - 1 - i] : src[i];
+}
+
+/* The same from the number an ascii file gave. */
+static void ply_put_attr_number(unsigned char *dst, double d, ply_type_t t) {
+  unsigned char b[8];
+  switch (t) {
+  case PT_F32:
+    scf__put_f32le(b, (float)d);
+    break;
+  case PT_F64:
+    scf__put_f64le(b, d);
+    break;
+  default: {
+    /* Integers: the value's low bytes, two's complement. */
+    uint64_t u = (uint64_t)(int64_t)d;
+    if (d >= 9223372036854775808.0)
+      u = (uint64_t)d;
+    for (int i = 0; i < 8; i++)
+      b[i] = (unsigned char)(u >> (8 * i));
+  }
+  }
+  memcpy(dst, b, ply_type_size(t));
+}
+
 static void ply_free(ply_t *p) {
+  free(p->amap);
   for (size_t i = 0; i < p->n_elems; i++)
     free(p->elems[i].props);
   free(p->elems);
@@ -445,6 +482,8 @@ static int ply_binary_elem(scf__rd_t *r, const ply_t *p, size_t ei,
   size_t got;
   uint64_t skipped;
   int rc;
+  /* A point's attribute record: at most one 8-byte value per property. */
+  unsigned char arec[PLY_MAX_PROPS * 8];
 
   if (e->fixed && role == ROLE_OTHER) {
     uint64_t start = scf__rd_offset(r);
@@ -473,6 +512,13 @@ static int ply_binary_elem(scf__rd_t *r, const ply_t *p, size_t ei,
                           ply_double(b + pp[p->px].offset, pp[p->px].type, be),
                           ply_double(b + pp[p->py].offset, pp[p->py].type, be),
                           ply_double(b + pp[p->pz].offset, pp[p->pz].type, be));
+      if (rc == 0 && role == ROLE_VERTEX && p->amap != NULL) {
+        for (size_t j = 0; j < e->n_props; j++)
+          if (p->amap[j] >= 0)
+            ply_put_attr(arec + v->attrs->props[p->amap[j]].offset,
+                         b + pp[j].offset, pp[j].type, be);
+        rc = scf__attrs_push(r, v, arec);
+      }
       if (rc < 0)
         return rc;
       continue;
@@ -494,6 +540,9 @@ static int ply_binary_elem(scf__rd_t *r, const ply_t *p, size_t ei,
             xyz[1] = ply_double(b, pp->type, be);
           else if ((int)j == p->pz)
             xyz[2] = ply_double(b, pp->type, be);
+          else if (p->amap != NULL && p->amap[j] >= 0)
+            ply_put_attr(arec + v->attrs->props[p->amap[j]].offset, b, pp->type,
+                         be);
         }
         continue;
       }
@@ -536,7 +585,8 @@ static int ply_binary_elem(scf__rd_t *r, const ply_t *p, size_t ei,
         return ply_truncated(r, rec, at, e, k, bytes, skipped);
     }
     if (role == ROLE_VERTEX &&
-        (rc = scf__vbuf_push(r, v, xyz[0], xyz[1], xyz[2])) < 0)
+        ((rc = scf__vbuf_push(r, v, xyz[0], xyz[1], xyz[2])) < 0 ||
+         (p->amap != NULL && (rc = scf__attrs_push(r, v, arec)) < 0)))
       return rc;
   }
   return 0;
@@ -580,6 +630,7 @@ static int ply_ascii_elem(tokens_t *ts, const ply_t *p, size_t ei,
                                   : ROLE_OTHER;
   char *tok = NULL, buf[SCF__SHOW_MAX + 4], what[PLY_NAME + 32];
   int rc;
+  unsigned char arec[PLY_MAX_PROPS * 8]; /* as in ply_binary_elem() */
   if (role == ROLE_VERTEX && (rc = ply_reserve(r, p, v)) < 0)
     return rc;
   for (uint64_t k = 0; k < e->count; k++) {
@@ -606,6 +657,9 @@ static int ply_ascii_elem(tokens_t *ts, const ply_t *p, size_t ei,
             xyz[1] = d;
           else if ((int)j == p->pz)
             xyz[2] = d;
+          else if (p->amap != NULL && p->amap[j] >= 0)
+            ply_put_attr_number(arec + v->attrs->props[p->amap[j]].offset, d,
+                                pp->type);
         }
         continue;
       }
@@ -650,7 +704,8 @@ static int ply_ascii_elem(tokens_t *ts, const ply_t *p, size_t ei,
       }
     }
     if (role == ROLE_VERTEX &&
-        (rc = scf__vbuf_push(r, v, xyz[0], xyz[1], xyz[2])) < 0)
+        ((rc = scf__vbuf_push(r, v, xyz[0], xyz[1], xyz[2])) < 0 ||
+         (p->amap != NULL && (rc = scf__attrs_push(r, v, arec)) < 0)))
       return rc;
   }
   return 0;
@@ -662,6 +717,27 @@ int scf__read_ply(scf__rd_t *r, scf__vbuf_t *v, scf__tbuf_t *t) {
   int rc = ply_header(r, &p, t != NULL);
   if (rc == 0)
     rc = ply_check_size(r, &p);
+  if (rc == 0 && v->attrs != NULL && p.vertex >= 0) {
+    /* Every scalar property of the vertices but x, y, z, in file order. */
+    const ply_elem_t *e = &p.elems[p.vertex];
+    p.amap = malloc((e->n_props ? e->n_props : 1) * sizeof *p.amap);
+    if (p.amap == NULL)
+      rc = scf__fail(r->msg, r->msg_len, SCF_ENOMEM, r->path,
+                     "out of memory for the point properties");
+    for (size_t j = 0; rc == 0 && j < e->n_props; j++) {
+      const ply_prop_t *pp = &e->props[j];
+      p.amap[j] = -1;
+      if (pp->count_type != PT_NONE || (int)j == p.px || (int)j == p.py ||
+          (int)j == p.pz)
+        continue;
+      p.amap[j] = (int)v->attrs->count;
+      rc = scf__attrs_add(r, v->attrs, pp->name, ply_scf_type(pp->type));
+    }
+    if (rc == 0 && v->attrs->count == 0) {
+      free(p.amap);
+      p.amap = NULL;
+    }
+  }
   tokens_t ts = {r, NULL};
   for (size_t i = 0; rc == 0 && i <= ply_last_needed(&p); i++)
     rc = p.format == PLY_ASCII ? ply_ascii_elem(&ts, &p, i, v, t)
@@ -670,15 +746,54 @@ int scf__read_ply(scf__rd_t *r, scf__vbuf_t *v, scf__tbuf_t *t) {
   return rc;
 }
 
+/* Prints one attribute value, read from its little-endian record bytes. */
+static int ply_print_attr(scf__aout_t *o, const unsigned char *b,
+                          scf_type_t t) {
+  uint64_t u = 0;
+  for (size_t i = 0; i < scf_type_size(t); i++)
+    u |= (uint64_t)b[i] << (8 * i);
+  switch (t) {
+  case SCF_TYPE_INT8:
+    return scf__out_printf(o, " %d", (int)(int8_t)u);
+  case SCF_TYPE_INT16:
+    return scf__out_printf(o, " %d", (int)(int16_t)u);
+  case SCF_TYPE_INT32:
+    return scf__out_printf(o, " %ld", (long)(int32_t)u);
+  case SCF_TYPE_FLOAT32: {
+    uint32_t w = (uint32_t)u;
+    float f;
+    memcpy(&f, &w, sizeof f);
+    return scf__out_printf(o, " %.9g", (double)f);
+  }
+  case SCF_TYPE_FLOAT64: {
+    double d;
+    memcpy(&d, &u, sizeof d);
+    return scf__out_printf(o, " %.17g", d);
+  }
+  default: /* the unsigned ones */
+    return scf__out_printf(o, " %llu", (scf__ull)u);
+  }
+}
+
 int scf__write_ply(scf__aout_t *o, const scf__mesh_in_t *m, int ascii) {
+  const scf_attrs_t *a = m->attrs;
+  /* The input's own normals win over the computed ones. */
+  const double *normals = scf_attrs_find(a, "nx") >= 0 ||
+                                  scf_attrs_find(a, "ny") >= 0 ||
+                                  scf_attrs_find(a, "nz") >= 0
+                              ? NULL
+                              : m->normals;
   int rc = scf__out_printf(o,
                            "ply\nformat %s 1.0\ncomment written by shortcrust\n"
                            "element vertex %zu\nproperty double x\n"
                            "property double y\nproperty double z\n",
                            ascii ? "ascii" : "binary_little_endian", m->n);
-  if (rc == 0 && m->normals != NULL)
+  if (rc == 0 && normals != NULL)
     rc = scf__out_printf(o, "property float nx\nproperty float ny\n"
                             "property float nz\n");
+  for (size_t k = 0; rc == 0 && a != NULL && k < a->count; k++)
+    rc = scf__out_printf(o, "property %s %s\n", scf_type_name(a->props[k].type),
+                         a->props[k].name);
   /* Indices go out as int, the type most readers expect, unless they do
    * not fit. */
   if (rc == 0)
@@ -686,26 +801,36 @@ int scf__write_ply(scf__aout_t *o, const scf__mesh_in_t *m, int ascii) {
                          "element face %zu\nproperty list uchar %s "
                          "vertex_indices\nend_header\n",
                          m->nt, m->n > INT32_MAX ? "uint" : "int");
+  const size_t stride = a != NULL ? a->stride : 0;
+  unsigned char *vrec = malloc(36 + stride);
+  if (rc == 0 && vrec == NULL)
+    rc = scf__fail(o->msg, o->msg_len, SCF_ENOMEM, o->path, "out of memory");
   for (size_t i = 0; rc == 0 && i < m->n; i++) {
     const double *p = m->xyz + 3 * i;
-    const double *q = m->normals ? m->normals + 3 * i : NULL;
+    const double *q = normals ? normals + 3 * i : NULL;
+    const unsigned char *ar = a != NULL ? a->data + i * stride : NULL;
     if (ascii) {
       rc = scf__out_printf(o, "%.17g %.17g %.17g", p[0], p[1], p[2]);
       if (rc == 0 && q != NULL)
         rc = scf__out_printf(o, " %.9g %.9g %.9g", (double)(float)q[0],
                              (double)(float)q[1], (double)(float)q[2]);
+      for (size_t k = 0; rc == 0 && ar != NULL && k < a->count; k++)
+        rc = ply_print_attr(o, ar + a->props[k].offset, a->props[k].type);
       if (rc == 0)
         rc = scf__out_write(o, "\n", 1);
     } else {
-      unsigned char rec[36];
       for (int c = 0; c < 3; c++) {
-        scf__put_f64le(rec + 8 * c, p[c]);
+        scf__put_f64le(vrec + 8 * c, p[c]);
         if (q != NULL)
-          scf__put_f32le(rec + 24 + 4 * c, (float)q[c]);
+          scf__put_f32le(vrec + 24 + 4 * c, (float)q[c]);
       }
-      rc = scf__out_write(o, rec, q != NULL ? 36 : 24);
+      size_t len = q != NULL ? 36 : 24;
+      if (ar != NULL)
+        memcpy(vrec + len, ar, stride);
+      rc = scf__out_write(o, vrec, len + stride);
     }
   }
+  free(vrec);
   for (size_t i = 0; rc == 0 && i < m->nt; i++) {
     const uint32_t *t = m->tri + 3 * i;
     if (ascii) {

@@ -196,7 +196,15 @@ static inline int scf__rd_bytes(scf__rd_t *r, size_t n, const unsigned char **p,
 typedef struct scf__vbuf {
   double *xyz;
   size_t count, cap;
+  scf_attrs_t *attrs; /* NULL when the caller wants x, y, z only */
+  size_t acap;        /* points attrs->data has room for */
 } scf__vbuf_t;
+
+/* Appends one point's record of attrs->stride bytes (attrs.c). */
+int scf__attrs_push(scf__rd_t *r, scf__vbuf_t *v, const unsigned char *rec);
+/* Adds a property at the end of every record (no points yet): 0 or < 0. */
+int scf__attrs_add(scf__rd_t *r, scf_attrs_t *a, const char *name,
+                   scf_type_t type);
 
 typedef struct scf__tbuf {
   uint32_t *idx;
@@ -416,6 +424,7 @@ typedef struct scf__mesh_in {
   const uint32_t *tri;
   size_t nt;
   const double *normals;
+  const scf_attrs_t *attrs; /* NULL or with points == n */
 } scf__mesh_in_t;
 
 /* The writers of each format; ascii picks the text variant of PLY and STL. */

@@ -96,6 +96,59 @@ int scf_points_read(const char *path, scf_points_t *out, char *msg,
 void scf_points_free(scf_points_t *p);
 
 /*
+ * Per-point properties carried from an input file to the mesh written from
+ * it: colours, normals, intensity, confidence, anything a scanner adds.
+ * Each property keeps its name and its type; the values are stored per
+ * point, one record of `stride` bytes each, the property's value at
+ * props[k].offset in the record, little-endian, in its own type. Values
+ * are copied, never converted, so they come out exactly as they went in.
+ */
+typedef enum scf_type {
+  SCF_TYPE_INT8 = 1,
+  SCF_TYPE_UINT8,
+  SCF_TYPE_INT16,
+  SCF_TYPE_UINT16,
+  SCF_TYPE_INT32,
+  SCF_TYPE_UINT32,
+  SCF_TYPE_FLOAT32,
+  SCF_TYPE_FLOAT64
+} scf_type_t;
+
+typedef struct scf_prop {
+  char name[32];
+  scf_type_t type;
+  size_t offset; /* in a point's record */
+} scf_prop_t;
+
+typedef struct scf_attrs {
+  scf_prop_t *props;
+  size_t count;        /* properties */
+  size_t stride;       /* bytes per point */
+  unsigned char *data; /* stride * points bytes */
+  size_t points;
+} scf_attrs_t;
+
+/* Bytes of a value of the type (1, 2, 4 or 8); 0 for an unknown type. */
+size_t scf_type_size(scf_type_t t);
+/* The PLY name of the type ("uchar", "float", ...). */
+const char *scf_type_name(scf_type_t t);
+
+/*
+ * scf_points_read(), also filling *attrs with the per-point properties the
+ * file holds besides x, y and z: every scalar property of a PLY file's
+ * vertex element, in the file's order. Other formats give none (count 0).
+ * *attrs is zeroed on failure; release it with scf_attrs_free().
+ */
+int scf_points_read_attrs(const char *path, scf_points_t *out,
+                          scf_attrs_t *attrs, char *msg, size_t msg_len);
+/* Releases the properties and zeroes *a; accepts NULL and a zeroed struct. */
+void scf_attrs_free(scf_attrs_t *a);
+/* The index of the property of that name, or -1. */
+int scf_attrs_find(const scf_attrs_t *a, const char *name);
+/* Removes the named property and its values; 1 when it was there. */
+int scf_attrs_remove(scf_attrs_t *a, const char *name);
+
+/*
  * Reads a triangle mesh: vertices into *pts and 3 * *n_tri vertex indices
  * into *tri (malloc'd; release with free()). Formats by extension: .ply
  * (the "vertex" element and the "vertex_indices" or "vertex_index" list of
@@ -154,6 +207,22 @@ int scf_mesh_format_from_path(const char *path, int ascii,
 int scf_mesh_write(const char *path, scf_mesh_format_t fmt, const double *xyz,
                    size_t n_points, const uint32_t *tri, size_t n_tri,
                    const double *normals, char *msg, size_t msg_len);
+
+/*
+ * scf_mesh_write() with per-point properties (attrs may be NULL; otherwise
+ * attrs->points must be n_points). PLY writes every property after x, y, z,
+ * unchanged in name, type and value; when they include nx, ny or nz, the
+ * given normals are not written (the input's own normals win: drop them
+ * from attrs to write the computed ones). OBJ writes the colours of
+ * properties red, green and blue as `v x y z r g b`, scaled to [0, 1] (by
+ * 255 for uchar, 65535 for ushort; floats as they are). OFF and STL have no
+ * place for them.
+ */
+int scf_mesh_write_attrs(const char *path, scf_mesh_format_t fmt,
+                         const double *xyz, size_t n_points,
+                         const uint32_t *tri, size_t n_tri,
+                         const double *normals, const scf_attrs_t *attrs,
+                         char *msg, size_t msg_len);
 
 /*
  * Replaces the file at path with len bytes of data, atomically in the same

@@ -60,6 +60,26 @@ if [ -w /dev/full ]; then
     sh -c '"$1" reconstruct "$2" -o - -q > /dev/full' sh "$sc" "$knot"
 fi
 
+# The input's per-point properties reach the mesh unchanged: a mesh read
+# back as points keeps its normals (so a second run writes the same file),
+# and colours added to it come out on the same vertices, in PLY and OBJ.
+"$sc" reconstruct "$knot" -o "$tmp/attr1.ply" --ascii -q || fail "ascii PLY"
+"$sc" reconstruct "$tmp/attr1.ply" -o "$tmp/attr2.ply" --ascii -q || fail "PLY with normals"
+cmp -s "$tmp/attr1.ply" "$tmp/attr2.ply" || fail "the input's normals did not come through"
+awk '/^property float nz$/ { print; print "property uchar red"; print "property uchar green"; print "property uchar blue"; next }
+     /^end_header$/ { print; body = 1; next }
+     body && NF == 6 { n++; print $0, n % 256, 7, 200; next }
+     { print }' "$tmp/attr1.ply" > "$tmp/attr3.ply"
+"$sc" reconstruct "$tmp/attr3.ply" -o "$tmp/attr4.ply" --ascii -q || fail "coloured PLY"
+cmp -s "$tmp/attr3.ply" "$tmp/attr4.ply" || fail "colours were not carried unchanged"
+"$sc" reconstruct "$tmp/attr3.ply" -o "$tmp/attr5.obj" -q || fail "coloured PLY to OBJ"
+grep -q '^v .* 0.00392156863 0.0274509804 0.784313725$' "$tmp/attr5.obj" ||
+  fail "OBJ lacks the colours: $(grep -m 1 '^v ' "$tmp/attr5.obj")"
+"$sc" reconstruct "$tmp/attr3.ply" -o "$tmp/attr6.ply" --ascii -q --mesh-normals ||
+  fail "--mesh-normals"
+grep -q "property uchar red" "$tmp/attr6.ply" && [ "$(grep -c 'property float n' "$tmp/attr6.ply")" -eq 3 ] ||
+  fail "--mesh-normals: $(grep property "$tmp/attr6.ply")"
+
 # The report is JSON with the diagnostics; --quiet prints nothing.
 expect 0 "" "$sc" reconstruct "$knot" -o "$tmp/q.ply" --quiet --report "$tmp/r.json"
 [ -s "$tmp/out" ] && fail "--quiet printed: $(cat "$tmp/out")"
@@ -153,7 +173,7 @@ expect 1 "collinear" "$sc" reconstruct "$tmp/line.xyz" -o "$tmp/old.ply"
 printf 'ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0\n' > "$tmp/trunc.ply"
 expect 1 "trunc.ply" "$sc" reconstruct "$tmp/trunc.ply" -o "$tmp/old.ply"
 [ "$(cat "$tmp/old.ply")" = keep ] || fail "a failed run replaced the old output"
-ls "$tmp" | grep -q -v -E '^(old.ply|out|err|nan.xyz|line.xyz|trunc.ply|knot\..*|q.ply|r.json|s.ply|t.ply|b.ply|d.ply|d1.ply|d2.ply|dn.json|noisy.xyz|f1|f2|v1|v2|file.ply|piped.ply|piped2.ply|cut.ply)$' &&
+ls "$tmp" | grep -q -v -E '^(old.ply|out|err|nan.xyz|line.xyz|trunc.ply|knot\..*|q.ply|r.json|s.ply|t.ply|b.ply|d.ply|d1.ply|d2.ply|dn.json|noisy.xyz|f1|f2|v1|v2|file.ply|piped.ply|piped2.ply|cut.ply|attr[1-6].(ply|obj))$' &&
   fail "temporary files left: $(ls "$tmp")"
 
 [ "$fails" -eq 0 ] && echo "all passed"

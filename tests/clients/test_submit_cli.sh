@@ -144,6 +144,17 @@ grep -q '"jobs_failed_total": 2[,}]' "$tmp/out" || fail "stats --json: two jobs 
 cmp -s "$tmp/piped.ply" "$tmp/file.ply" || fail "submit through a pipe differs"
 grep -q "standard input: 3200 points" "$tmp/err" || fail "submit summary on stderr: $(cat "$tmp/err")"
 
+# The input's properties (here its normals and added colours) come out on
+# the same vertices, as reconstruct writes them; nothing new travels.
+"$sc" reconstruct "$data/knot1_points.ply" -o "$tmp/attr1.ply" --ascii -q || fail "ascii PLY"
+awk '/^property float nz$/ { print; print "property uchar red"; next }
+     /^end_header$/ { print; body = 1; next }
+     body && NF == 6 { n++; print $0, n % 256; next }
+     { print }' "$tmp/attr1.ply" > "$tmp/attr2.ply"
+"$sc" submit "$tmp/attr2.ply" -o "$tmp/attr3.ply" --ascii -q --socket "$sock" ||
+  fail "submit of a coloured PLY"
+cmp -s "$tmp/attr2.ply" "$tmp/attr3.ply" || fail "submit did not carry the properties"
+
 stop_daemon
 [ "$fails" -eq 0 ] || { echo "$fails check(s) failed" >&2; cat "$tmp/daemon.log" >&2; exit 1; }
 echo "all submit, stats and ping checks passed"

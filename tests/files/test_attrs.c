@@ -1,0 +1,220 @@
+/*
+ * Per-point properties: every scalar property of a PLY file's vertices
+ * (each type, in ascii and both binary byte orders, with a list property
+ * among them) is read with its name and type and written back on the same
+ * vertex of the mesh unchanged, in binary and ascii PLY; the input's
+ * normals win over computed ones; OBJ gets the colours; a property can be
+ * removed.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include "plybuf.h"
+#include "sct_assert.h"
+#include "shortcrust_files.h"
+
+enum { N = 5 };
+
+/* The value of property t of point i, in range for every type. */
+static double value(ty_t t, size_t i) {
+  const double v = (double)(i * 37 % 101) - 40 + (t >= F32 ? 0.125 : 0);
+  return t == U8 || t == U16 || t == U32 ? v + 50 : v;
+}
+
+/* A PLY of N points with one property of each type between x and y, a list
+ * of bytes after z (which makes the records variable in size), and a
+ * face. */
+static void write_input(const char *path, int fmt) {
+  buf_t b = {0};
+  buf_printf(&b, "ply\nformat %s 1.0\nelement vertex %d\nproperty double x\n",
+             fmt_name[fmt], N);
+  for (int t = 0; t < TY_COUNT; t++)
+    buf_printf(&b, "property %s p_%s\n", ty_name[t], ty_name[t]);
+  buf_printf(&b, "property float y\nproperty float z\n"
+                 "property list uchar uchar tags\nelement face 1\n"
+                 "property list uchar int vertex_indices\nend_header\n");
+  for (size_t i = 0; i < N; i++) {
+    buf_val(&b, fmt, F64, (double)i);
+    for (int t = 0; t < TY_COUNT; t++)
+      buf_val(&b, fmt, (ty_t)t, value((ty_t)t, i));
+    buf_val(&b, fmt, F32, (double)(i * i));
+    buf_val(&b, fmt, F32, (double)(i % 2));
+    buf_val(&b, fmt, U8, 2);
+    buf_val(&b, fmt, U8, 7);
+    buf_val(&b, fmt, U8, 9);
+    buf_eol(&b, fmt);
+  }
+  buf_val(&b, fmt, U8, 3);
+  for (int k = 0; k < 3; k++)
+    buf_val(&b, fmt, I32, k);
+  buf_eol(&b, fmt);
+  buf_write(&b, path);
+  buf_free(&b);
+}
+
+/* The value of property k of point i, decoded. */
+static double get(const scf_attrs_t *a, size_t i, size_t k) {
+  const unsigned char *p = a->data + i * a->stride + a->props[k].offset;
+  uint64_t u = 0;
+  for (size_t j = 0; j < scf_type_size(a->props[k].type); j++)
+    u |= (uint64_t)p[j] << (8 * j);
+  switch (a->props[k].type) {
+  case SCF_TYPE_INT8:
+    return (int8_t)u;
+  case SCF_TYPE_INT16:
+    return (int16_t)u;
+  case SCF_TYPE_INT32:
+    return (int32_t)u;
+  case SCF_TYPE_FLOAT32: {
+    uint32_t w = (uint32_t)u;
+    float f;
+    memcpy(&f, &w, sizeof f);
+    return f;
+  }
+  case SCF_TYPE_FLOAT64: {
+    double d;
+    memcpy(&d, &u, sizeof d);
+    return d;
+  }
+  default:
+    return (double)u;
+  }
+}
+
+/* The properties are those of write_input(), by name, type and value. */
+static void check_attrs(const scf_attrs_t *a, const char *what) {
+  EXPECT_MSG(a->count == TY_COUNT && a->points == N,
+             "%s: %zu properties, %zu "
+             "points",
+             what, a->count, a->points);
+  for (size_t k = 0; k < a->count && k < TY_COUNT; k++) {
+    char name[32];
+    snprintf(name, sizeof name, "p_%s", ty_name[k]);
+    EXPECT_STR_EQ(a->props[k].name, name);
+    EXPECT_EQ((int)a->props[k].type, (int)k + 1);
+    for (size_t i = 0; i < a->points; i++)
+      EXPECT_MSG(get(a, i, k) == ty_round((ty_t)k, value((ty_t)k, i)),
+                 "%s: point %zu, %s: %g", what, i, name, get(a, i, k));
+  }
+}
+
+static void round_trips(void) {
+  const uint32_t tri[3] = {0, 1, 2};
+  const double normals[3 * N] = {0};
+  for (int fmt = 0; fmt < FMT_COUNT; fmt++) {
+    const char *in = tmp_path("in.ply");
+    write_input(in, fmt);
+    char msg[256];
+    scf_points_t pts;
+    scf_attrs_t a;
+    ASSERT_MSG(scf_points_read_attrs(in, &pts, &a, msg, sizeof msg) == 0, "%s",
+               msg);
+    EXPECT_EQ(pts.count, (size_t)N);
+    EXPECT(pts.count == N && pts.xyz[3 * 3 + 1] == 9.0);
+    check_attrs(&a, fmt_name[fmt]);
+    for (int ascii = 0; ascii < 2; ascii++) {
+      const char *out = tmp_path("out.ply");
+      EXPECT_MSG(
+          scf_mesh_write_attrs(
+              out, ascii ? SCF_MESH_FMT_PLY_ASCII : SCF_MESH_FMT_PLY_BINARY,
+              pts.xyz, pts.count, tri, 1, normals, &a, msg, sizeof msg) == 0,
+          "%s", msg);
+      scf_points_t back;
+      scf_attrs_t b;
+      ASSERT_MSG(scf_points_read_attrs(out, &back, &b, msg, sizeof msg) == 0,
+                 "%s", msg);
+      /* The computed normals come before the properties. */
+      EXPECT_EQ(scf_attrs_find(&b, "nx"), 0);
+      EXPECT(scf_attrs_remove(&b, "nx") && scf_attrs_remove(&b, "ny") &&
+             scf_attrs_remove(&b, "nz"));
+      EXPECT(!scf_attrs_remove(&b, "nx"));
+      check_attrs(&b, ascii ? "written ascii" : "written binary");
+      scf_points_free(&back);
+      scf_attrs_free(&b);
+    }
+    scf_points_free(&pts);
+    scf_attrs_free(&a);
+  }
+  /* Without asking, no properties; a text file has none. */
+  scf_attrs_t none;
+  scf_points_t pts;
+  char msg[256];
+  write_bytes(tmp_path("p.xyz"), "0 0 0 5\n1 0 0 6\n", 16);
+  EXPECT_EQ(
+      scf_points_read_attrs(tmp_path("p.xyz"), &pts, &none, msg, sizeof msg),
+      0);
+  EXPECT(none.count == 0 && none.data == NULL);
+  scf_points_free(&pts);
+}
+
+/* Normals among the input's properties are written instead of computed
+ * ones; removing them lets the computed ones through. */
+static void input_normals(void) {
+  buf_t b = {0};
+  buf_printf(&b, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                 "property float y\nproperty float z\nproperty float nx\n"
+                 "property float ny\nproperty float nz\nproperty uchar red\n"
+                 "property uchar green\nproperty uchar blue\nend_header\n"
+                 "0 0 0 0 0 1 255 0 0\n1 0 0 0 0 1 0 255 0\n"
+                 "0 1 0 0 0 1 0 0 51\n");
+  buf_write(&b, tmp_path("n.ply"));
+  buf_free(&b);
+  char msg[256];
+  scf_points_t pts;
+  scf_attrs_t a;
+  ASSERT_MSG(
+      scf_points_read_attrs(tmp_path("n.ply"), &pts, &a, msg, sizeof msg) == 0,
+      "%s", msg);
+  const uint32_t tri[3] = {0, 1, 2};
+  const double computed[9] = {0, 0, -1, 0, 0, -1, 0, 0, -1};
+  EXPECT(scf_mesh_write_attrs(tmp_path("o.ply"), SCF_MESH_FMT_PLY_ASCII,
+                              pts.xyz, 3, tri, 1, computed, &a, msg,
+                              sizeof msg) == 0);
+  scf_points_t back;
+  scf_attrs_t c;
+  ASSERT(scf_points_read_attrs(tmp_path("o.ply"), &back, &c, msg, sizeof msg) ==
+         0);
+  int nz = scf_attrs_find(&c, "nz");
+  EXPECT(c.count == 6 && nz == 2 && get(&c, 0, (size_t)nz) == 1.0);
+  scf_points_free(&back);
+  scf_attrs_free(&c);
+  /* OBJ: the colours, scaled to [0, 1]. */
+  EXPECT(scf_mesh_write_attrs(tmp_path("o.obj"), SCF_MESH_FMT_OBJ, pts.xyz, 3,
+                              tri, 1, NULL, &a, msg, sizeof msg) == 0);
+  FILE *f = fopen(tmp_path("o.obj"), "r");
+  char line[256] = "", v3[256] = "";
+  while (f && fgets(line, sizeof line, f))
+    if (strncmp(line, "v ", 2) == 0)
+      snprintf(v3, sizeof v3, "%s", line);
+  if (f)
+    fclose(f);
+  EXPECT_STR_EQ(v3, "v 0 1 0 0 0 0.2\n");
+  /* Without them, the computed normals. */
+  scf_attrs_remove(&a, "nx");
+  scf_attrs_remove(&a, "ny");
+  scf_attrs_remove(&a, "nz");
+  EXPECT_EQ(a.count, (size_t)3);
+  EXPECT(scf_mesh_write_attrs(tmp_path("o.ply"), SCF_MESH_FMT_PLY_BINARY,
+                              pts.xyz, 3, tri, 1, computed, &a, msg,
+                              sizeof msg) == 0);
+  ASSERT(scf_points_read_attrs(tmp_path("o.ply"), &back, &c, msg, sizeof msg) ==
+         0);
+  nz = scf_attrs_find(&c, "nz");
+  EXPECT(c.count == 6 && nz == 2 && get(&c, 2, (size_t)nz) == -1.0);
+  EXPECT_EQ(get(&c, 2, (size_t)scf_attrs_find(&c, "blue")), 51.0);
+  /* Properties for another number of points are refused. */
+  EXPECT_EQ(scf_mesh_write_attrs(tmp_path("x.ply"), SCF_MESH_FMT_PLY_BINARY,
+                                 pts.xyz, 2, tri, 0, NULL, &a, msg, sizeof msg),
+            SCF_EINVAL);
+  scf_points_free(&back);
+  scf_attrs_free(&c);
+  scf_points_free(&pts);
+  scf_attrs_free(&a);
+}
+
+int main(void) {
+  tmp_init();
+  round_trips();
+  input_normals();
+  return sct_finish("files_attrs");
+}
