@@ -18,10 +18,12 @@
 static void usage(FILE *f) {
   fputs("usage: shortcrust reconstruct IN -o OUT [options]\n\n"
         "Reconstructs a triangle mesh from the points of IN and writes it to\n"
-        "OUT. IN may be .ply (ascii or binary), .xyz/.txt/.pts/.csv, .off or\n"
-        ".obj (a mesh file gives its vertices). OUT's extension picks the\n"
-        "format: .ply (binary unless --ascii), .off, .obj or .stl. Every input\n"
-        "point is written, in input order, so triangle indices refer to IN.\n\n"
+        "OUT. IN may be .ply (ascii or binary), .xyz/.txt/.pts/.csv, .off,\n"
+        ".obj (a mesh file gives its vertices) or .las (LAS 1.0 to 1.4; for\n"
+        ".laz, decompress first: laszip -i in.laz -o out.las). OUT's\n"
+        "extension picks the format: .ply (binary unless --ascii), .off, .obj\n"
+        "or .stl. Every input point is written, in input order, so triangle\n"
+        "indices refer to IN.\n\n"
         "options:\n",
         f);
   sc_cli_job_usage_params(f, 1);
