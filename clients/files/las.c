@@ -88,11 +88,15 @@ static double load_f64le(const unsigned char *b) {
 /*
  * A coordinate as LAS defines it, value * scale + offset, in two
  * statements so that no compiler fuses them into one fma and the result
- * is the same everywhere.
+ * is the same everywhere. The int32 is sign-extended by arithmetic, which,
+ * unlike a cast of a large uint32_t, is defined by the standard; compilers
+ * make it one instruction.
  */
 static inline double las_coord(const unsigned char *b, double scale,
                                double offset) {
-  double scaled = (double)(int32_t)(uint32_t)scf__load_uint(b, 4, 0) * scale;
+  uint32_t u = (uint32_t)scf__load_uint(b, 4, 0);
+  int64_t v = (int64_t)u - ((int64_t)(u & 0x80000000u) << 1);
+  double scaled = (double)v * scale;
   return scaled + offset;
 }
 
