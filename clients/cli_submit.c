@@ -26,11 +26,12 @@ static void usage(FILE *f) {
       "reconstructs the mesh, and writes the mesh to OUT. Formats, summary\n"
       "and report are those of `shortcrust reconstruct`, and so are the\n"
       "triangles for the same input and options. IN may be .ply (ascii or\n"
-      "binary), .xyz/.txt/.pts/.csv, .off or .obj; OUT's extension picks the\n"
-      "format: .ply (binary unless --ascii), .off, .obj or .stl; - is\n"
-      "standard input or output, as for reconstruct. The daemon\n"
-      "reconstructs on one thread; options that leave their default are not\n"
-      "sent, and a daemon too old to take the others refuses the job.\n\n"
+      "binary), .xyz/.txt/.pts/.csv, .off, .obj or .las (not .laz); OUT's\n"
+      "extension picks the format: .ply (binary unless --ascii), .off, .obj\n"
+      "or .stl; - is standard input or output, as for reconstruct. The\n"
+      "daemon reconstructs on one thread; options that leave their default\n"
+      "are not sent, and a daemon too old to take the others refuses the\n"
+      "job.\n\n"
       "options:\n",
       f);
   sc_cli_job_usage_params(f, 0);

@@ -34,7 +34,8 @@ static enum scf__kind kind_of(const char *path) {
     enum scf__kind kind;
   } table[] = {{"ply", SCF__K_PLY}, {"xyz", SCF__K_XYZ}, {"txt", SCF__K_XYZ},
                {"pts", SCF__K_PTS}, {"csv", SCF__K_CSV}, {"off", SCF__K_OFF},
-               {"obj", SCF__K_OBJ}, {"stl", SCF__K_STL}};
+               {"obj", SCF__K_OBJ}, {"stl", SCF__K_STL}, {"las", SCF__K_LAS},
+               {"laz", SCF__K_LAZ}};
   for (size_t i = 0; i < sizeof table / sizeof table[0]; i++)
     if (strcmp(ext, table[i].ext) == 0)
       return table[i].kind;
@@ -68,6 +69,8 @@ static int read_any(const char *path, scf_points_t *pts, uint32_t **tri,
     msg[0] = '\0';
   if (pts != NULL)
     memset(pts, 0, sizeof *pts);
+  if (attrs != NULL)
+    memset(attrs, 0, sizeof *attrs);
   if (tri != NULL)
     *tri = NULL;
   if (n_tri != NULL)
@@ -79,15 +82,17 @@ static int read_any(const char *path, scf_points_t *pts, uint32_t **tri,
   int mesh = n_tri != NULL;
   if (kind == SCF__K_NONE ||
       (mesh &&
-       (kind == SCF__K_XYZ || kind == SCF__K_CSV || kind == SCF__K_PTS)) ||
+       (kind == SCF__K_XYZ || kind == SCF__K_CSV || kind == SCF__K_PTS ||
+        kind == SCF__K_LAS || kind == SCF__K_LAZ)) ||
       (!mesh && kind == SCF__K_STL))
     return unknown_extension(path, msg, msg_len,
                              mesh ? ".ply, .off, .obj or .stl"
-                                  : ".ply, .xyz, .txt, .pts, .csv, .off or "
-                                    ".obj");
+                                  : ".ply, .xyz, .txt, .pts, .csv, .off, .obj "
+                                    "or .las");
+  /* No LAZ decoder is linked in: say so before opening the file. */
+  if (kind == SCF__K_LAZ)
+    return scf__refuse_laz(path, msg, msg_len);
   scf__rd_t r;
-  if (attrs != NULL)
-    memset(attrs, 0, sizeof *attrs);
   scf__vbuf_t v = {NULL, 0, 0, attrs, 0};
   scf__tbuf_t t = {NULL, 0, 0};
   scf__tbuf_t *tp = mesh ? &t : NULL;
@@ -121,6 +126,9 @@ static int read_any(const char *path, scf_points_t *pts, uint32_t **tri,
       break;
     case SCF__K_STL:
       rc = scf__read_stl(&r, &v, tp);
+      break;
+    case SCF__K_LAS:
+      rc = scf__read_las(&r, &v);
       break;
     default:
       rc = scf__read_xyz(&r, kind, &v);

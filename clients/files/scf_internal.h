@@ -2,8 +2,8 @@
  * Internals of the point and mesh file module, shared by its source files:
  * messages (errors.c), the buffered reader and growing arrays (reader.c),
  * the atomic writer (atomic.c), and the reader and writer of each format
- * (ply.c, text.c, off.c, obj.c, stl.c) that the dispatcher (dispatch.c)
- * picks by the file's extension.
+ * (ply.c, text.c, off.c, obj.c, stl.c; las.c reads only) that the
+ * dispatcher (dispatch.c) picks by the file's extension.
  *
  * The helpers that run once per line, token, value or record are static
  * inline here, so that each format's hot loop has them inlined as it did
@@ -60,6 +60,8 @@ enum scf__kind {
   SCF__K_OFF,
   SCF__K_OBJ,
   SCF__K_STL,
+  SCF__K_LAS,
+  SCF__K_LAZ, /* known only to be refused */
   SCF__K_STDIO /* "-": standard input (PLY or XYZ, by PLY's magic) or output */
 };
 
@@ -386,6 +388,11 @@ int scf__read_xyz(scf__rd_t *r, enum scf__kind kind, scf__vbuf_t *v);
 int scf__read_off(scf__rd_t *r, scf__vbuf_t *v, scf__tbuf_t *t);
 int scf__read_obj(scf__rd_t *r, scf__vbuf_t *v, scf__tbuf_t *t);
 int scf__read_stl(scf__rd_t *r, scf__vbuf_t *v, scf__tbuf_t *t);
+int scf__read_las(scf__rd_t *r, scf__vbuf_t *v);
+
+/* The SCF_EUNSUPPORTED message for a .laz file, which says how to
+ * decompress it (las.c). */
+int scf__refuse_laz(const char *path, char *msg, size_t msg_len);
 
 /*
  * Atomic output (atomic.c): a temporary file beside the target, renamed

@@ -1,9 +1,9 @@
 /*
  * Point and mesh files: the one place that reads and writes PLY, XYZ-like
- * text, OFF, OBJ and STL, shared by the local command and the client. The
- * module's public names start with scf_ (SCF_ for constants), to keep them
- * apart from the core's sc_ names; the internals shared between its source
- * files (scf_internal.h) start with scf__.
+ * text, OFF, OBJ and STL, and reads LAS, shared by the local command and
+ * the client. The module's public names start with scf_ (SCF_ for
+ * constants), to keep them apart from the core's sc_ names; the internals
+ * shared between its source files (scf_internal.h) start with scf__.
  *
  * Readers stream the file through a fixed buffer, so a file is never held in
  * memory whole, and they check every count a header declares against the
@@ -79,11 +79,20 @@ typedef struct scf_points {
  *                             skipped.
  *   .off                      OFF (also COFF, NOFF, CNOFF, STOFF): vertices.
  *   .obj                      Wavefront OBJ: the 'v' lines.
+ *   .las                      LAS 1.0 to 1.4, point data record formats 0
+ *                             to 10: X * scale + offset of every point
+ *                             record (likewise Y, Z); other fields, the
+ *                             variable-length records and bytes after the
+ *                             points are skipped. LAZ (.laz, or a .las file
+ *                             whose format byte marks compression) is
+ *                             refused with SCF_EUNSUPPORTED: decompress it
+ *                             first (laszip, pdal translate).
  *   -                         standard input: PLY when it starts with the
  *                             line "ply", else .xyz text.
- * PLY and OFF files must start with their magic word. A non-finite number
- * ("nan", "inf") is returned as it is; a token that is not a number is an
- * error. A file without points is not an error: count is 0 and xyz NULL.
+ * PLY and OFF files must start with their magic word, LAS files with
+ * "LASF". A non-finite number ("nan", "inf") is returned as it is; a token
+ * that is not a number is an error. A file without points is not an
+ * error: count is 0 and xyz NULL.
  *
  * On success returns 0 and fills *out, which the caller releases with
  * scf_points_free(). On failure returns a negative SCF_E* code, leaves

@@ -12,7 +12,7 @@ knot=$data/knot1_points.ply
 expect 0 "usage: shortcrust reconstruct" "$sc" reconstruct --help
 for opt in --output --mode --r --theta --max-hole --paper-pruning --threads \
            --denoise --denoise-scale --smoothed-vertices \
-           --report --ascii --no-normals --quiet; do
+           --report --ascii --no-normals --quiet .las .laz; do
   grep -q -- "$opt" "$tmp/out" || fail "--help does not mention $opt"
 done
 expect 0 "reconstruct" "$sc" --help
@@ -165,6 +165,8 @@ rm -f "$tmp/tet.xyz" "$tmp/tet.off" "$tmp/five.xyz" "$tmp/five.off" "$tmp/five.j
 
 echo "keep" > "$tmp/old.ply"
 expect 1 "missing.ply" "$sc" reconstruct "$tmp/missing.ply" -o "$tmp/old.ply"
+expect 1 "scan.laz: LAZ (compressed LAS) is not supported: decompress it first" \
+  "$sc" reconstruct "$tmp/scan.laz" -o "$tmp/old.ply"
 printf '0 0 0\n1 0 0\n0 nan 1\n0 0 1\n1 1 1\n' > "$tmp/nan.xyz"
 expect 1 "nan.xyz: point 2 has a non-finite y coordinate" \
   "$sc" reconstruct "$tmp/nan.xyz" -o "$tmp/old.ply"

@@ -22,7 +22,7 @@ start_daemon "$scd" "$sc" --workers 2
 expect 0 "usage: shortcrust submit" "$sc" submit --help
 for opt in --output --mode --r --theta --max-hole --paper-pruning --labels --rho --alpha \
            --denoise --denoise-scale --smoothed-vertices \
-           --socket --report --ascii --no-normals --quiet; do
+           --socket --report --ascii --no-normals --quiet .las .laz; do
   grep -q -- "$opt" "$tmp/out" || fail "submit --help does not mention $opt"
 done
 expect 0 "submit" "$sc" --help

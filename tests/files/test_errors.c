@@ -584,8 +584,8 @@ static void test_unreadable(void) {
   expect_fail(dir, 0, SCF_EIO, "is a directory", NULL);
 
   /* The extension is judged before the file is looked at. */
-  expect_fail(tmp_path("points.las"), 0, SCF_EUNSUPPORTED,
-              "unknown extension '.las'", "expected .ply, .xyz");
+  expect_fail(tmp_path("points.e57"), 0, SCF_EUNSUPPORTED,
+              "unknown extension '.e57'", "expected .ply, .xyz");
   expect_fail(tmp_path("points"), 0, SCF_EUNSUPPORTED, "no file extension",
               NULL);
   expect_fail(tmp_path("dir.ply/points"), 0, SCF_EUNSUPPORTED,
