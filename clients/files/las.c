@@ -1,7 +1,9 @@
 /*
  * LAS (ASPRS LIDAR Data Exchange Format), versions 1.0 to 1.4, point data
- * record formats 0 to 10: the x, y, z of every point record. LAZ, its
- * compressed form, is refused with a message that says how to decompress.
+ * record formats 0 to 10: the x, y, z of every point record and, when
+ * asked, its attributes (intensity, returns, classification, GPS time,
+ * colour, near infrared). LAZ, its compressed form, is refused with a
+ * message that says how to decompress.
  *
  * A LAS file is a public header (227 bytes in 1.0 to 1.2, 235 in 1.3, 375
  * in 1.4, or more when the header size field says so), variable-length
@@ -19,13 +21,12 @@
 /*
  * The point data record formats: the smallest record of each and where its
  * fields start, 0 meaning that the format lacks the field (offset 0 is
- * always X). Every record begins with int32 X, Y and Z at 0, 4 and 8, and
- * only those are read now; the other columns are here so that attributes
- * can be read from the same table. Formats 6 to 10 (LAS 1.4) keep the
- * return number and the number of returns in 4 bits each and the
- * classification in a byte of its own ("wide"); formats 0 to 5 pack them
- * into 3 + 3 bits and 5 bits plus flags. A record may be longer than its
- * format's minimum: the extra bytes that follow are skipped.
+ * always X). Every record begins with int32 X, Y and Z at 0, 4 and 8; the
+ * attributes are read from the columns here (the wave packets are not). Formats
+ * 6 to 10 (LAS 1.4) keep the return number and the number of returns in 4 bits
+ * each and the classification in a byte of its own ("wide"); formats 0 to 5
+ * pack them into 3 + 3 bits and 5 bits plus flags. A record may be longer than
+ * its format's minimum: the extra bytes that follow are skipped.
  */
 typedef struct las_format {
   uint8_t min_len;   /* bytes */
@@ -234,6 +235,53 @@ static int las_check_size(scf__rd_t *r, const las_header_t *h) {
   return 0;
 }
 
+/* The attributes of a format, as per-point properties named as PLY files
+ * name them: intensity, return_number, number_of_returns,
+ * classification, then gps_time, red, green, blue and nir where the format
+ * has them. */
+static int las_attrs_add(scf__rd_t *r, scf_attrs_t *a, const las_format_t *f) {
+  int rc = scf__attrs_add(r, a, "intensity", SCF_TYPE_UINT16);
+  if (rc == 0)
+    rc = scf__attrs_add(r, a, "return_number", SCF_TYPE_UINT8);
+  if (rc == 0)
+    rc = scf__attrs_add(r, a, "number_of_returns", SCF_TYPE_UINT8);
+  if (rc == 0)
+    rc = scf__attrs_add(r, a, "classification", SCF_TYPE_UINT8);
+  if (rc == 0 && f->gps_time)
+    rc = scf__attrs_add(r, a, "gps_time", SCF_TYPE_FLOAT64);
+  if (rc == 0 && f->rgb)
+    rc = scf__attrs_add(r, a, "red", SCF_TYPE_UINT16);
+  if (rc == 0 && f->rgb)
+    rc = scf__attrs_add(r, a, "green", SCF_TYPE_UINT16);
+  if (rc == 0 && f->rgb)
+    rc = scf__attrs_add(r, a, "blue", SCF_TYPE_UINT16);
+  if (rc == 0 && f->nir)
+    rc = scf__attrs_add(r, a, "nir", SCF_TYPE_UINT16);
+  return rc;
+}
+
+/* One record's attributes, in the order of las_attrs_add(); both are
+ * little-endian, so values are copied byte for byte. */
+static void las_attrs_record(unsigned char *out, const unsigned char *b,
+                             const las_format_t *f) {
+  const unsigned ret = b[f->returns];
+  memcpy(out, b + f->intensity, 2);
+  out[2] = (unsigned char)(f->wide ? ret & 0x0F : ret & 0x07);
+  out[3] = (unsigned char)(f->wide ? ret >> 4 : (ret >> 3) & 0x07);
+  out[4] = (unsigned char)(f->wide ? b[f->classes] : b[f->classes] & 0x1F);
+  size_t at = 5;
+  if (f->gps_time) {
+    memcpy(out + at, b + f->gps_time, 8);
+    at += 8;
+  }
+  if (f->rgb) {
+    memcpy(out + at, b + f->rgb, 6);
+    at += 6;
+  }
+  if (f->nir)
+    memcpy(out + at, b + f->nir, 2);
+}
+
 int scf__read_las(scf__rd_t *r, scf__vbuf_t *v) {
   las_header_t h;
   int rc;
@@ -257,6 +305,10 @@ int scf__read_las(scf__rd_t *r, scf__vbuf_t *v) {
     return scf__rd_fail_byte(r, scf__rd_offset(r), SCF_EFORMAT,
                              "file ends before the point data at byte %llu",
                              (scf__ull)h.data_offset);
+  const las_format_t *f = &las_formats[h.format];
+  unsigned char arec[32]; /* the largest: 5 + 8 + 6 + 2 bytes */
+  if (v->attrs != NULL && (rc = las_attrs_add(r, v->attrs, f)) < 0)
+    return rc;
   uint64_t n = h.count;
   /* Without a known file size the count is unchecked: grow as data comes. */
   uint64_t reserve = r->size == UINT64_MAX && n > 65536 ? 65536 : n;
@@ -283,11 +335,17 @@ int scf__read_las(scf__rd_t *r, scf__vbuf_t *v) {
                                "%zu bytes, got %zu)",
                                (scf__ull)k, (scf__ull)n, len, got);
     }
-    for (size_t i = 0; i < whole; i++, b += len)
+    for (size_t i = 0; i < whole; i++, b += len) {
       if ((rc = scf__vbuf_push(r, v, las_coord(b, s[0], o[0]),
                                las_coord(b + 4, s[1], o[1]),
                                las_coord(b + 8, s[2], o[2]))) < 0)
         return rc;
+      if (v->attrs != NULL) {
+        las_attrs_record(arec, b, f);
+        if ((rc = scf__attrs_push(r, v, arec)) < 0)
+          return rc;
+      }
+    }
     r->pos += whole * len;
     k += whole;
   }

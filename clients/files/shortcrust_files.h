@@ -81,12 +81,15 @@ typedef struct scf_points {
  *   .obj                      Wavefront OBJ: the 'v' lines.
  *   .las                      LAS 1.0 to 1.4, point data record formats 0
  *                             to 10: X * scale + offset of every point
- *                             record (likewise Y, Z); other fields, the
- *                             variable-length records and bytes after the
- *                             points are skipped. LAZ (.laz, or a .las file
- *                             whose format byte marks compression) is
- *                             refused with SCF_EUNSUPPORTED: decompress it
- *                             first (laszip, pdal translate).
+ *                             record (likewise Y, Z); with
+ *                             scf_points_read_attrs(), also intensity,
+ *                             return_number, number_of_returns,
+ *                             classification and, where the format has
+ *                             them, gps_time, red, green, blue, nir. Wave
+ *                             packets, the variable-length records and
+ *                             bytes after the points are skipped. LAZ (.laz, or
+ * a .las file whose format byte marks compression) is refused with
+ * SCF_EUNSUPPORTED: decompress it first (laszip, pdal translate).
  *   -                         standard input: PLY when it starts with the
  *                             line "ply", else .xyz text.
  * PLY and OFF files must start with their magic word, LAS files with
@@ -145,7 +148,8 @@ const char *scf_type_name(scf_type_t t);
 /*
  * scf_points_read(), also filling *attrs with the per-point properties the
  * file holds besides x, y and z: every scalar property of a PLY file's
- * vertex element, in the file's order. Other formats give none (count 0).
+ * vertex element, in the file's order; a LAS file's point attributes (see
+ * above). Other formats give none (count 0).
  * *attrs is zeroed on failure; release it with scf_attrs_free().
  */
 int scf_points_read_attrs(const char *path, scf_points_t *out,

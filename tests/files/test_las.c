@@ -581,6 +581,61 @@ static void test_laz(void) {
   }
 }
 
+/* The attributes, from the specification's record layouts (a table of
+ * this test's own): every format's fields come back as properties with
+ * the record's values, the packed return and class bits unpacked. */
+static void test_attributes(void) {
+  static const struct {
+    unsigned gps, rgb, nir; /* offsets, 0 when absent */
+  } lay[11] = {{0, 0, 0},    {20, 0, 0},  {0, 20, 0},  {20, 28, 0},
+               {20, 0, 0},   {20, 28, 0}, {22, 0, 0},  {22, 30, 0},
+               {22, 30, 36}, {22, 0, 0},  {22, 30, 36}};
+  enum { NP = 40 };
+  int32_t *xyz = make_xyz(NP);
+  for (unsigned format = 0; format <= 10; format++) {
+    las_spec_t spec = {4,         format, 0,  0, 0, {0.01, 0.01, 0.01},
+                       {0, 0, 0}, NP,     xyz};
+    buf_t b;
+    las_build(&b, &spec);
+    const char *path = tmp_path("attrs.las");
+    buf_write(&b, path);
+    scf_points_t pts;
+    scf_attrs_t a;
+    char msg[256];
+    ASSERT_MSG(scf_points_read_attrs(path, &pts, &a, msg, sizeof msg) == 0,
+               "format %u: %s", format, msg);
+    const size_t want = 4 + (lay[format].gps ? 1 : 0) +
+                        (lay[format].rgb ? 3 : 0) + (lay[format].nir ? 1 : 0);
+    EXPECT_MSG(a.count == want && a.points == NP,
+               "format %u: %zu properties for %zu points", format, a.count,
+               a.points);
+    const int wide = format >= 6;
+    for (size_t k = 0; k < NP && a.count == want; k++) {
+      const unsigned char *rec = b.p + b.n - (NP - k) * min_len[format];
+      const unsigned char *ar = a.data + k * a.stride;
+#define PROP(name) (ar + a.props[scf_attrs_find(&a, name)].offset)
+      EXPECT(memcmp(PROP("intensity"), rec + 12, 2) == 0);
+      EXPECT_EQ(*PROP("return_number"), wide ? rec[14] & 15 : rec[14] & 7);
+      EXPECT_EQ(*PROP("number_of_returns"),
+                wide ? rec[14] >> 4 : (rec[14] >> 3) & 7);
+      EXPECT_EQ(*PROP("classification"), wide ? rec[16] : rec[15] & 31);
+      if (lay[format].gps)
+        EXPECT(memcmp(PROP("gps_time"), rec + lay[format].gps, 8) == 0);
+      if (lay[format].rgb)
+        EXPECT(memcmp(PROP("red"), rec + lay[format].rgb, 2) == 0 &&
+               memcmp(PROP("green"), rec + lay[format].rgb + 2, 2) == 0 &&
+               memcmp(PROP("blue"), rec + lay[format].rgb + 4, 2) == 0);
+      if (lay[format].nir)
+        EXPECT(memcmp(PROP("nir"), rec + lay[format].nir, 2) == 0);
+#undef PROP
+    }
+    scf_points_free(&pts);
+    scf_attrs_free(&a);
+    buf_free(&b);
+  }
+  free(xyz);
+}
+
 int main(void) {
   tmp_init();
   test_versions_and_formats();
@@ -589,5 +644,6 @@ int main(void) {
   test_every_cut();
   test_pipe();
   test_laz();
+  test_attributes();
   return sct_finish("files_las");
 }
