@@ -149,7 +149,10 @@ const char *scf_type_name(scf_type_t t);
  * scf_points_read(), also filling *attrs with the per-point properties the
  * file holds besides x, y and z: every scalar property of a PLY file's
  * vertex element, in the file's order; a LAS file's point attributes (see
- * above). Other formats give none (count 0).
+ * above); a text file's numeric columns after x, y, z, as doubles named by
+ * a .csv header or f0, f1, ... (when the first point's further columns
+ * are all numbers; every later line must then have as many, or the read
+ * fails with SCF_EFORMAT). OFF and OBJ give none (count 0).
  * *attrs is zeroed on failure; release it with scf_attrs_free().
  */
 int scf_points_read_attrs(const char *path, scf_points_t *out,

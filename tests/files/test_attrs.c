@@ -135,11 +135,11 @@ static void round_trips(void) {
     scf_points_free(&pts);
     scf_attrs_free(&a);
   }
-  /* Without asking, no properties; a text file has none. */
+  /* A text file of three columns has none. */
   scf_attrs_t none;
   scf_points_t pts;
   char msg[256];
-  write_bytes(tmp_path("p.xyz"), "0 0 0 5\n1 0 0 6\n", 16);
+  write_bytes(tmp_path("p.xyz"), "0 0 0\n1 0 0\n", 12);
   EXPECT_EQ(
       scf_points_read_attrs(tmp_path("p.xyz"), &pts, &none, msg, sizeof msg),
       0);
@@ -212,9 +212,71 @@ static void input_normals(void) {
   scf_attrs_free(&a);
 }
 
+/* Text columns after x, y, z: doubles named by a .csv header or f0, f1,
+ * ...; a line with another number of them fails; a label column is not a
+ * property. */
+static void text_columns(void) {
+  char msg[256];
+  scf_points_t pts;
+  scf_attrs_t a;
+  const char xyz[] = "0 0 0 5 -1.5\n1 0 0 6 2.25 # comment\n";
+  write_bytes(tmp_path("c.xyz"), xyz, sizeof xyz - 1);
+  ASSERT_MSG(
+      scf_points_read_attrs(tmp_path("c.xyz"), &pts, &a, msg, sizeof msg) == 0,
+      "%s", msg);
+  EXPECT(a.count == 2 && a.points == 2);
+  EXPECT(a.count == 2 && strcmp(a.props[0].name, "f0") == 0 &&
+         strcmp(a.props[1].name, "f1") == 0 &&
+         a.props[1].type == SCF_TYPE_FLOAT64);
+  EXPECT(a.count == 2 && get(&a, 0, 0) == 5 && get(&a, 1, 1) == 2.25);
+  scf_points_free(&pts);
+  scf_attrs_free(&a);
+
+  const char csv[] = "x,y,z,intensity,quality\n0,0,0,7,0.5\n1,0,0,8,0.25\n";
+  write_bytes(tmp_path("c.csv"), csv, sizeof csv - 1);
+  ASSERT_MSG(
+      scf_points_read_attrs(tmp_path("c.csv"), &pts, &a, msg, sizeof msg) == 0,
+      "%s", msg);
+  EXPECT(a.count == 2 && strcmp(a.props[0].name, "intensity") == 0 &&
+         strcmp(a.props[1].name, "quality") == 0 && get(&a, 1, 1) == 0.25);
+  /* Into a PLY and back: the same names and values. */
+  const uint32_t tri[3] = {0, 1, 1};
+  EXPECT(scf_mesh_write_attrs(tmp_path("c.ply"), SCF_MESH_FMT_PLY_BINARY,
+                              pts.xyz, 2, tri, 0, NULL, &a, msg,
+                              sizeof msg) == 0);
+  scf_points_free(&pts);
+  scf_attrs_free(&a);
+  ASSERT(scf_points_read_attrs(tmp_path("c.ply"), &pts, &a, msg, sizeof msg) ==
+         0);
+  EXPECT(a.count == 2 && strcmp(a.props[0].name, "intensity") == 0 &&
+         get(&a, 0, 0) == 7 && get(&a, 1, 1) == 0.25);
+  scf_points_free(&pts);
+  scf_attrs_free(&a);
+
+  const char ragged[] = "0 0 0 1 2\n1 0 0 3\n";
+  write_bytes(tmp_path("r.xyz"), ragged, sizeof ragged - 1);
+  EXPECT_EQ(scf_points_read_attrs(tmp_path("r.xyz"), &pts, &a, msg, sizeof msg),
+            SCF_EFORMAT);
+  EXPECT_STR_CONTAINS(msg, "line 2: 1 columns after x, y, z, but the first "
+                           "point had 2");
+  EXPECT(pts.count == 0 && a.count == 0 && a.data == NULL);
+  /* Without asking, the same file reads as before. */
+  EXPECT_EQ(scf_points_read(tmp_path("r.xyz"), &pts, msg, sizeof msg), 0);
+  EXPECT_EQ(pts.count, (size_t)2);
+  scf_points_free(&pts);
+
+  const char label[] = "0 0 0 wall\n1 0 0 roof 3\n";
+  write_bytes(tmp_path("l.xyz"), label, sizeof label - 1);
+  EXPECT_EQ(scf_points_read_attrs(tmp_path("l.xyz"), &pts, &a, msg, sizeof msg),
+            0);
+  EXPECT(pts.count == 2 && a.count == 0);
+  scf_points_free(&pts);
+}
+
 int main(void) {
   tmp_init();
   round_trips();
   input_normals();
+  text_columns();
   return sct_finish("files_attrs");
 }
