@@ -38,7 +38,8 @@ test-tsan: setup
 	cmake --build $(BUILD)-tsan -j $(JOBS)
 	cd $(BUILD)-tsan && ctest --output-on-failure -j $(JOBS) -LE slow -R '^(daemon|clients)_'
 
-# The protocol decoder under libFuzzer, ASan and UBSan (clang), for FUZZ_SECONDS.
+# The protocol decoder and the file readers under libFuzzer, ASan and UBSan
+# (clang), for FUZZ_SECONDS each.
 FUZZ_SECONDS ?= 60
 fuzz: setup
 	bash tests/proto/run-fuzz.sh $(BUILD)-fuzz $(FUZZ_SECONDS)
