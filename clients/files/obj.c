@@ -80,6 +80,34 @@ int scf__read_obj(scf__rd_t *r, scf__vbuf_t *v, scf__tbuf_t *t) {
   return 0;
 }
 
+/* A property's value from its little-endian bytes. */
+static double obj_value(const unsigned char *b, scf_type_t t) {
+  uint64_t u = 0;
+  for (size_t i = 0; i < scf_type_size(t); i++)
+    u |= (uint64_t)b[i] << (8 * i);
+  switch (t) {
+  case SCF_TYPE_INT8:
+    return (int8_t)u;
+  case SCF_TYPE_INT16:
+    return (int16_t)u;
+  case SCF_TYPE_INT32:
+    return (int32_t)u;
+  case SCF_TYPE_FLOAT32: {
+    uint32_t w = (uint32_t)u;
+    float f;
+    memcpy(&f, &w, sizeof f);
+    return f;
+  }
+  case SCF_TYPE_FLOAT64: {
+    double d;
+    memcpy(&d, &u, sizeof d);
+    return d;
+  }
+  default:
+    return (double)u;
+  }
+}
+
 /* A colour channel of the record scaled to [0, 1]: integers by their
  * type's largest value, floats as they are. */
 static double obj_channel(const unsigned char *b, scf_type_t t) {
@@ -136,15 +164,28 @@ int scf__write_obj(scf__aout_t *o, const scf__mesh_in_t *m) {
     if (rc == 0)
       rc = scf__out_write(o, "\n", 1);
   }
-  for (size_t i = 0; rc == 0 && m->normals != NULL && i < m->n; i++) {
-    const double *q = m->normals + 3 * i;
+  /* The input's own normals win over the computed ones, as in PLY. */
+  const int nx = scf_attrs_find(at, "nx"), ny = scf_attrs_find(at, "ny"),
+            nz = scf_attrs_find(at, "nz");
+  const int own = nx >= 0 && ny >= 0 && nz >= 0;
+  const int vn = own || m->normals != NULL;
+  for (size_t i = 0; rc == 0 && vn && i < m->n; i++) {
+    double q[3];
+    if (own) {
+      const unsigned char *ar = at->data + i * at->stride;
+      q[0] = obj_value(ar + at->props[nx].offset, at->props[nx].type);
+      q[1] = obj_value(ar + at->props[ny].offset, at->props[ny].type);
+      q[2] = obj_value(ar + at->props[nz].offset, at->props[nz].type);
+    } else {
+      memcpy(q, m->normals + 3 * i, sizeof q);
+    }
     rc = scf__out_printf(o, "vn %.9g %.9g %.9g\n", q[0], q[1], q[2]);
   }
   for (size_t i = 0; rc == 0 && i < m->nt; i++) {
     scf__ull a = (scf__ull)m->tri[3 * i] + 1,
              b = (scf__ull)m->tri[3 * i + 1] + 1,
              c = (scf__ull)m->tri[3 * i + 2] + 1;
-    if (m->normals != NULL)
+    if (vn)
       rc = scf__out_printf(o, "f %llu//%llu %llu//%llu %llu//%llu\n", a, a, b,
                            b, c, c);
     else

@@ -231,7 +231,8 @@ int scf_mesh_write(const char *path, scf_mesh_format_t fmt, const double *xyz,
  * given normals are not written (the input's own normals win: drop them
  * from attrs to write the computed ones). OBJ writes the colours of
  * properties red, green and blue as `v x y z r g b`, scaled to [0, 1] (by
- * 255 for uchar, 65535 for ushort; floats as they are). OFF and STL have no
+ * 255 for uchar, 65535 for ushort; floats as they are), and its `vn`
+ * lines from nx, ny, nz when the properties have them. OFF and STL have no
  * place for them.
  */
 int scf_mesh_write_attrs(const char *path, scf_mesh_format_t fmt,

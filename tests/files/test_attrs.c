@@ -189,6 +189,14 @@ static void input_normals(void) {
   if (f)
     fclose(f);
   EXPECT_STR_EQ(v3, "v 0 1 0 0 0 0.2\n");
+  /* ... and the input's normals as vn, not the computed ones. */
+  f = fopen(tmp_path("o.obj"), "r");
+  int vn_up = 0;
+  while (f && fgets(line, sizeof line, f))
+    vn_up += strcmp(line, "vn 0 0 1\n") == 0;
+  if (f)
+    fclose(f);
+  EXPECT_EQ(vn_up, 3);
   /* Without them, the computed normals. */
   scf_attrs_remove(&a, "nx");
   scf_attrs_remove(&a, "ny");
