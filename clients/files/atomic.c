@@ -51,6 +51,19 @@ void scf__aout_abort(scf__aout_t *o) {
   o->tmp = NULL;
 }
 
+/* A buffered stream over o->fd, the last step of opening either kind of
+ * output. */
+static int open_stream(scf__aout_t *o) {
+  o->fp = fdopen(o->fd, "wb");
+  if (o->fp == NULL) {
+    int rc = scf__aout_errno(o, "fdopen failed");
+    scf__aout_abort(o);
+    return rc;
+  }
+  setvbuf(o->fp, NULL, _IOFBF, (size_t)1 << 20);
+  return 0;
+}
+
 int scf__aout_open(scf__aout_t *o, const char *path, char *msg,
                    size_t msg_len) {
   memset(o, 0, sizeof *o);
@@ -65,14 +78,7 @@ int scf__aout_open(scf__aout_t *o, const char *path, char *msg,
     o->fd = fcntl(STDOUT_FILENO, F_DUPFD_CLOEXEC, 0);
     if (o->fd < 0)
       return scf__aout_errno(o, "cannot duplicate it");
-    o->fp = fdopen(o->fd, "wb");
-    if (o->fp == NULL) {
-      int rc = scf__aout_errno(o, "fdopen failed");
-      scf__aout_abort(o);
-      return rc;
-    }
-    setvbuf(o->fp, NULL, _IOFBF, (size_t)1 << 20);
-    return 0;
+    return open_stream(o);
   }
   const char *slash = strrchr(path, '/');
   const char *base = slash ? slash + 1 : path;
@@ -106,14 +112,7 @@ int scf__aout_open(scf__aout_t *o, const char *path, char *msg,
     scf__aout_abort(o);
     return rc;
   }
-  o->fp = fdopen(o->fd, "wb");
-  if (o->fp == NULL) {
-    int rc = scf__aout_errno(o, "fdopen failed");
-    scf__aout_abort(o);
-    return rc;
-  }
-  setvbuf(o->fp, NULL, _IOFBF, (size_t)1 << 20);
-  return 0;
+  return open_stream(o);
 }
 
 int scf__aout_commit(scf__aout_t *o) {

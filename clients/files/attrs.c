@@ -31,6 +31,37 @@ const char *scf_type_name(scf_type_t t) {
   return scf_type_size(t) ? names[t] : "";
 }
 
+int64_t scf__integer(const unsigned char *b, scf_type_t t, int big_endian) {
+  const size_t n = scf_type_size(t);
+  uint64_t u = scf__load_uint(b, n, big_endian);
+  if (t == SCF_TYPE_INT8 || t == SCF_TYPE_INT16 || t == SCF_TYPE_INT32) {
+    uint64_t top = (uint64_t)1 << (8 * n - 1);
+    return (u & top) ? (int64_t)u - (int64_t)(top << 1) : (int64_t)u;
+  }
+  return (int64_t)u;
+}
+
+double scf__number(const unsigned char *b, scf_type_t t, int big_endian) {
+  if (t == SCF_TYPE_FLOAT32) {
+    uint32_t w = (uint32_t)scf__load_uint(b, 4, big_endian);
+    float f;
+    memcpy(&f, &w, sizeof f);
+    return f;
+  }
+  if (t == SCF_TYPE_FLOAT64) {
+    uint64_t w = scf__load_uint(b, 8, big_endian);
+    double d;
+    memcpy(&d, &w, sizeof d);
+    return d;
+  }
+  return (double)scf__integer(b, t, big_endian);
+}
+
+double scf_attrs_value(const scf_attrs_t *a, size_t point, size_t prop) {
+  return scf__number(a->data + point * a->stride + a->props[prop].offset,
+                     a->props[prop].type, 0);
+}
+
 int scf__attrs_add(scf__rd_t *r, scf_attrs_t *a, const char *name,
                    scf_type_t type) {
   scf_prop_t *p = realloc(a->props, (a->count + 1) * sizeof *p);

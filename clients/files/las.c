@@ -79,13 +79,6 @@ int scf__refuse_laz(const char *path, char *msg, size_t msg_len) {
                    "LAZ (compressed LAS) is not supported: " LAS_DECOMPRESS);
 }
 
-static double load_f64le(const unsigned char *b) {
-  uint64_t w = scf__load_uint(b, 8, 0);
-  double d;
-  memcpy(&d, &w, sizeof d);
-  return d;
-}
-
 /*
  * A coordinate as LAS defines it, value * scale + offset, in two
  * statements so that no compiler fuses them into one fma and the result
@@ -192,8 +185,8 @@ static int las_header(scf__rd_t *r, las_header_t *h) {
   }
   static const char axes[3] = {'x', 'y', 'z'};
   for (int a = 0; a < 3; a++) {
-    h->scale[a] = load_f64le(b + LAS_SCALE + 8 * a);
-    h->offset[a] = load_f64le(b + LAS_OFFSET + 8 * a);
+    h->scale[a] = scf__number(b + LAS_SCALE + 8 * a, SCF_TYPE_FLOAT64, 0);
+    h->offset[a] = scf__number(b + LAS_OFFSET + 8 * a, SCF_TYPE_FLOAT64, 0);
     if (!isfinite(h->scale[a]) || h->scale[a] == 0)
       return scf__rd_fail_byte(r, (uint64_t)(LAS_SCALE + 8 * a), SCF_EFORMAT,
                                "%c scale factor %g is not a finite, non-zero "

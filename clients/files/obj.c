@@ -80,66 +80,14 @@ int scf__read_obj(scf__rd_t *r, scf__vbuf_t *v, scf__tbuf_t *t) {
   return 0;
 }
 
-/* A property's value from its little-endian bytes. */
-static double obj_value(const unsigned char *b, scf_type_t t) {
-  uint64_t u = 0;
-  for (size_t i = 0; i < scf_type_size(t); i++)
-    u |= (uint64_t)b[i] << (8 * i);
-  switch (t) {
-  case SCF_TYPE_INT8:
-    return (int8_t)u;
-  case SCF_TYPE_INT16:
-    return (int16_t)u;
-  case SCF_TYPE_INT32:
-    return (int32_t)u;
-  case SCF_TYPE_FLOAT32: {
-    uint32_t w = (uint32_t)u;
-    float f;
-    memcpy(&f, &w, sizeof f);
-    return f;
-  }
-  case SCF_TYPE_FLOAT64: {
-    double d;
-    memcpy(&d, &u, sizeof d);
-    return d;
-  }
-  default:
-    return (double)u;
-  }
-}
-
-/* A colour channel of the record scaled to [0, 1]: integers by their
- * type's largest value, floats as they are. */
-static double obj_channel(const unsigned char *b, scf_type_t t) {
-  uint64_t u = 0;
-  for (size_t i = 0; i < scf_type_size(t); i++)
-    u |= (uint64_t)b[i] << (8 * i);
-  switch (t) {
-  case SCF_TYPE_UINT8:
-    return (double)u / 255.0;
-  case SCF_TYPE_UINT16:
-    return (double)u / 65535.0;
-  case SCF_TYPE_INT8:
-    return (double)(int8_t)u / 127.0;
-  case SCF_TYPE_INT16:
-    return (double)(int16_t)u / 32767.0;
-  case SCF_TYPE_INT32:
-    return (double)(int32_t)u / 2147483647.0;
-  case SCF_TYPE_UINT32:
-    return (double)u / 4294967295.0;
-  case SCF_TYPE_FLOAT32: {
-    uint32_t w = (uint32_t)u;
-    float f;
-    memcpy(&f, &w, sizeof f);
-    return f;
-  }
-  case SCF_TYPE_FLOAT64: {
-    double d;
-    memcpy(&d, &u, sizeof d);
-    return d;
-  }
-  }
-  return 0;
+/* A colour channel scaled to [0, 1]: integers by their type's largest
+ * value, floats as they are. */
+static double obj_channel(const scf_attrs_t *a, size_t i, int k) {
+  static const double top[] = {1,     127,        255,       32767,
+                               65535, 2147483647, 4294967295.0};
+  const scf_type_t t = a->props[k].type;
+  const double v = scf_attrs_value(a, i, (size_t)k);
+  return t <= SCF_TYPE_UINT32 ? v / top[t] : v;
 }
 
 int scf__write_obj(scf__aout_t *o, const scf__mesh_in_t *m) {
@@ -154,12 +102,8 @@ int scf__write_obj(scf__aout_t *o, const scf__mesh_in_t *m) {
     const double *p = m->xyz + 3 * i;
     rc = scf__out_printf(o, "v %.17g %.17g %.17g", p[0], p[1], p[2]);
     if (rc == 0 && colours) {
-      const unsigned char *ar = at->data + i * at->stride;
-      rc = scf__out_printf(
-          o, " %.9g %.9g %.9g",
-          obj_channel(ar + at->props[cr].offset, at->props[cr].type),
-          obj_channel(ar + at->props[cg].offset, at->props[cg].type),
-          obj_channel(ar + at->props[cb].offset, at->props[cb].type));
+      rc = scf__out_printf(o, " %.9g %.9g %.9g", obj_channel(at, i, cr),
+                           obj_channel(at, i, cg), obj_channel(at, i, cb));
     }
     if (rc == 0)
       rc = scf__out_write(o, "\n", 1);
@@ -172,10 +116,9 @@ int scf__write_obj(scf__aout_t *o, const scf__mesh_in_t *m) {
   for (size_t i = 0; rc == 0 && vn && i < m->n; i++) {
     double q[3];
     if (own) {
-      const unsigned char *ar = at->data + i * at->stride;
-      q[0] = obj_value(ar + at->props[nx].offset, at->props[nx].type);
-      q[1] = obj_value(ar + at->props[ny].offset, at->props[ny].type);
-      q[2] = obj_value(ar + at->props[nz].offset, at->props[nz].type);
+      q[0] = scf_attrs_value(at, i, (size_t)nx);
+      q[1] = scf_attrs_value(at, i, (size_t)ny);
+      q[2] = scf_attrs_value(at, i, (size_t)nz);
     } else {
       memcpy(q, m->normals + 3 * i, sizeof q);
     }

@@ -40,61 +40,22 @@ static ply_type_t ply_type_of(const char *name) {
   return PT_NONE;
 }
 
+/* The types are numbered alike in both enums (shortcrust_files.h). */
+static scf_type_t ply_scf_type(ply_type_t t) { return (scf_type_t)t; }
+
 static size_t ply_type_size(ply_type_t t) {
-  switch (t) {
-  case PT_I8:
-  case PT_U8:
-    return 1;
-  case PT_I16:
-  case PT_U16:
-    return 2;
-  case PT_I32:
-  case PT_U32:
-  case PT_F32:
-    return 4;
-  case PT_F64:
-    return 8;
-  default:
-    return 0;
-  }
+  return scf_type_size(ply_scf_type(t));
 }
 
 static int ply_type_is_int(ply_type_t t) { return t >= PT_I8 && t <= PT_U32; }
 
-static int64_t sign_extend(uint64_t u, unsigned bits) {
-  uint64_t top = (uint64_t)1 << (bits - 1);
-  return (u & top) ? (int64_t)u - (int64_t)(top << 1) : (int64_t)u;
-}
-
 /* Integer types only (the header parser makes sure of that). */
 static int64_t ply_int(const unsigned char *b, ply_type_t t, int big_endian) {
-  uint64_t u = scf__load_uint(b, ply_type_size(t), big_endian);
-  switch (t) {
-  case PT_I8:
-    return sign_extend(u, 8);
-  case PT_I16:
-    return sign_extend(u, 16);
-  case PT_I32:
-    return sign_extend(u, 32);
-  default:
-    return (int64_t)u;
-  }
+  return scf__integer(b, ply_scf_type(t), big_endian);
 }
 
 static double ply_double(const unsigned char *b, ply_type_t t, int big_endian) {
-  if (t == PT_F32) {
-    uint32_t w = (uint32_t)scf__load_uint(b, 4, big_endian);
-    float f;
-    memcpy(&f, &w, sizeof f);
-    return f;
-  }
-  if (t == PT_F64) {
-    uint64_t w = scf__load_uint(b, 8, big_endian);
-    double d;
-    memcpy(&d, &w, sizeof d);
-    return d;
-  }
-  return (double)ply_int(b, t, big_endian);
+  return scf__number(b, ply_scf_type(t), big_endian);
 }
 
 #define PLY_NAME 32
@@ -130,9 +91,6 @@ typedef struct ply {
   uint64_t header_end; /* line number of end_header */
   int *amap; /* per vertex property: its index in the attributes, or -1 */
 } ply_t;
-
-/* The types are numbered alike in both enums. */
-static scf_type_t ply_scf_type(ply_type_t t) { return (scf_type_t)t; }
 
 /* Stores a value of type t, read from a file of the given byte order, in
  * an attribute record (little-endian). */
@@ -746,33 +704,15 @@ int scf__read_ply(scf__rd_t *r, scf__vbuf_t *v, scf__tbuf_t *t) {
   return rc;
 }
 
-/* Prints one attribute value, read from its little-endian record bytes. */
+/* Prints one attribute value from its little-endian record bytes (every
+ * integer type fits a double exactly). */
 static int ply_print_attr(scf__aout_t *o, const unsigned char *b,
                           scf_type_t t) {
-  uint64_t u = 0;
-  for (size_t i = 0; i < scf_type_size(t); i++)
-    u |= (uint64_t)b[i] << (8 * i);
-  switch (t) {
-  case SCF_TYPE_INT8:
-    return scf__out_printf(o, " %d", (int)(int8_t)u);
-  case SCF_TYPE_INT16:
-    return scf__out_printf(o, " %d", (int)(int16_t)u);
-  case SCF_TYPE_INT32:
-    return scf__out_printf(o, " %ld", (long)(int32_t)u);
-  case SCF_TYPE_FLOAT32: {
-    uint32_t w = (uint32_t)u;
-    float f;
-    memcpy(&f, &w, sizeof f);
-    return scf__out_printf(o, " %.9g", (double)f);
-  }
-  case SCF_TYPE_FLOAT64: {
-    double d;
-    memcpy(&d, &u, sizeof d);
-    return scf__out_printf(o, " %.17g", d);
-  }
-  default: /* the unsigned ones */
-    return scf__out_printf(o, " %llu", (scf__ull)u);
-  }
+  const double v = scf__number(b, t, 0);
+  return scf__out_printf(o, t == SCF_TYPE_FLOAT32   ? " %.9g"
+                            : t == SCF_TYPE_FLOAT64 ? " %.17g"
+                                                    : " %.0f",
+                         v);
 }
 
 int scf__write_ply(scf__aout_t *o, const scf__mesh_in_t *m, int ascii) {

@@ -363,6 +363,11 @@ static inline uint64_t scf__load_uint(const unsigned char *b, size_t n,
   return v;
 }
 
+/* A binary value of the type as a number (attrs.c): integers of every
+ * width, sign-extended where signed, and floats. */
+int64_t scf__integer(const unsigned char *b, scf_type_t t, int big_endian);
+double scf__number(const unsigned char *b, scf_type_t t, int big_endian);
+
 static inline void scf__put_u32le(unsigned char *b, uint32_t v) {
   for (int i = 0; i < 4; i++)
     b[i] = (unsigned char)(v >> (8 * i));

@@ -159,6 +159,9 @@ int scf_points_read_attrs(const char *path, scf_points_t *out,
                           scf_attrs_t *attrs, char *msg, size_t msg_len);
 /* Releases the properties and zeroes *a; accepts NULL and a zeroed struct. */
 void scf_attrs_free(scf_attrs_t *a);
+/* The value of property prop of point point, as a number (every type a
+ * property can have fits a double exactly). */
+double scf_attrs_value(const scf_attrs_t *a, size_t point, size_t prop);
 /* The index of the property of that name, or -1. */
 int scf_attrs_find(const scf_attrs_t *a, const char *name);
 /* Removes the named property and its values; 1 when it was there. */

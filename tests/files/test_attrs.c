@@ -52,35 +52,6 @@ static void write_input(const char *path, int fmt) {
   buf_free(&b);
 }
 
-/* The value of property k of point i, decoded. */
-static double get(const scf_attrs_t *a, size_t i, size_t k) {
-  const unsigned char *p = a->data + i * a->stride + a->props[k].offset;
-  uint64_t u = 0;
-  for (size_t j = 0; j < scf_type_size(a->props[k].type); j++)
-    u |= (uint64_t)p[j] << (8 * j);
-  switch (a->props[k].type) {
-  case SCF_TYPE_INT8:
-    return (int8_t)u;
-  case SCF_TYPE_INT16:
-    return (int16_t)u;
-  case SCF_TYPE_INT32:
-    return (int32_t)u;
-  case SCF_TYPE_FLOAT32: {
-    uint32_t w = (uint32_t)u;
-    float f;
-    memcpy(&f, &w, sizeof f);
-    return f;
-  }
-  case SCF_TYPE_FLOAT64: {
-    double d;
-    memcpy(&d, &u, sizeof d);
-    return d;
-  }
-  default:
-    return (double)u;
-  }
-}
-
 /* The properties are those of write_input(), by name, type and value. */
 static void check_attrs(const scf_attrs_t *a, const char *what) {
   EXPECT_MSG(a->count == TY_COUNT && a->points == N,
@@ -93,8 +64,9 @@ static void check_attrs(const scf_attrs_t *a, const char *what) {
     EXPECT_STR_EQ(a->props[k].name, name);
     EXPECT_EQ((int)a->props[k].type, (int)k + 1);
     for (size_t i = 0; i < a->points; i++)
-      EXPECT_MSG(get(a, i, k) == ty_round((ty_t)k, value((ty_t)k, i)),
-                 "%s: point %zu, %s: %g", what, i, name, get(a, i, k));
+      EXPECT_MSG(
+          scf_attrs_value(a, i, k) == ty_round((ty_t)k, value((ty_t)k, i)),
+          "%s: point %zu, %s: %g", what, i, name, scf_attrs_value(a, i, k));
   }
 }
 
@@ -175,7 +147,7 @@ static void input_normals(void) {
   ASSERT(scf_points_read_attrs(tmp_path("o.ply"), &back, &c, msg, sizeof msg) ==
          0);
   int nz = scf_attrs_find(&c, "nz");
-  EXPECT(c.count == 6 && nz == 2 && get(&c, 0, (size_t)nz) == 1.0);
+  EXPECT(c.count == 6 && nz == 2 && scf_attrs_value(&c, 0, (size_t)nz) == 1.0);
   scf_points_free(&back);
   scf_attrs_free(&c);
   /* OBJ: the colours, scaled to [0, 1]. */
@@ -208,8 +180,8 @@ static void input_normals(void) {
   ASSERT(scf_points_read_attrs(tmp_path("o.ply"), &back, &c, msg, sizeof msg) ==
          0);
   nz = scf_attrs_find(&c, "nz");
-  EXPECT(c.count == 6 && nz == 2 && get(&c, 2, (size_t)nz) == -1.0);
-  EXPECT_EQ(get(&c, 2, (size_t)scf_attrs_find(&c, "blue")), 51.0);
+  EXPECT(c.count == 6 && nz == 2 && scf_attrs_value(&c, 2, (size_t)nz) == -1.0);
+  EXPECT_EQ(scf_attrs_value(&c, 2, (size_t)scf_attrs_find(&c, "blue")), 51.0);
   /* Properties for another number of points are refused. */
   EXPECT_EQ(scf_mesh_write_attrs(tmp_path("x.ply"), SCF_MESH_FMT_PLY_BINARY,
                                  pts.xyz, 2, tri, 0, NULL, &a, msg, sizeof msg),
@@ -236,7 +208,8 @@ static void text_columns(void) {
   EXPECT(a.count == 2 && strcmp(a.props[0].name, "f0") == 0 &&
          strcmp(a.props[1].name, "f1") == 0 &&
          a.props[1].type == SCF_TYPE_FLOAT64);
-  EXPECT(a.count == 2 && get(&a, 0, 0) == 5 && get(&a, 1, 1) == 2.25);
+  EXPECT(a.count == 2 && scf_attrs_value(&a, 0, 0) == 5 &&
+         scf_attrs_value(&a, 1, 1) == 2.25);
   scf_points_free(&pts);
   scf_attrs_free(&a);
 
@@ -246,7 +219,8 @@ static void text_columns(void) {
       scf_points_read_attrs(tmp_path("c.csv"), &pts, &a, msg, sizeof msg) == 0,
       "%s", msg);
   EXPECT(a.count == 2 && strcmp(a.props[0].name, "intensity") == 0 &&
-         strcmp(a.props[1].name, "quality") == 0 && get(&a, 1, 1) == 0.25);
+         strcmp(a.props[1].name, "quality") == 0 &&
+         scf_attrs_value(&a, 1, 1) == 0.25);
   /* Into a PLY and back: the same names and values. */
   const uint32_t tri[3] = {0, 1, 1};
   EXPECT(scf_mesh_write_attrs(tmp_path("c.ply"), SCF_MESH_FMT_PLY_BINARY,
@@ -257,7 +231,7 @@ static void text_columns(void) {
   ASSERT(scf_points_read_attrs(tmp_path("c.ply"), &pts, &a, msg, sizeof msg) ==
          0);
   EXPECT(a.count == 2 && strcmp(a.props[0].name, "intensity") == 0 &&
-         get(&a, 0, 0) == 7 && get(&a, 1, 1) == 0.25);
+         scf_attrs_value(&a, 0, 0) == 7 && scf_attrs_value(&a, 1, 1) == 0.25);
   scf_points_free(&pts);
   scf_attrs_free(&a);
 
