@@ -13,62 +13,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
+#include "lasbuf.h"
 #include "sct_assert.h"
 #include "shortcrust.h"
 #include "shortcrust_files.h"
 #include "synth.h"
 
 enum { N = 4000 };
-static const unsigned min_len[11] = {20, 28, 26, 34, 57, 63,
-                                     30, 36, 38, 59, 67};
 static const double kScale = 1e-4, kOffset[3] = {500000, 4000000, 100};
-
-static void put(unsigned char *b, uint64_t v, int n) {
-  for (int i = 0; i < n; i++)
-    b[i] = (unsigned char)(v >> (8 * i));
-}
-
-static void put_f64(unsigned char *b, double d) {
-  uint64_t w;
-  memcpy(&w, &d, sizeof w);
-  put(b, w, 8);
-}
-
-static void write_las(const char *path, const int32_t *q, unsigned format) {
-  const unsigned minor = format >= 6 ? 4 : 2, len = min_len[format];
-  const unsigned hsize = minor == 4 ? 375 : 227;
-  unsigned char h[375];
-  memset(h, 0, sizeof h);
-  memcpy(h, "LASF", 4);
-  h[24] = 1;
-  h[25] = (unsigned char)minor;
-  put(h + 94, hsize, 2);
-  put(h + 96, hsize, 4);
-  h[104] = (unsigned char)format;
-  put(h + 105, len, 2);
-  if (format < 6)
-    put(h + 107, N, 4);
-  if (minor == 4)
-    put(h + 247, N, 8);
-  for (int a = 0; a < 3; a++) {
-    put_f64(h + 131 + 8 * a, kScale);
-    put_f64(h + 155 + 8 * a, kOffset[a]);
-  }
-  FILE *f = fopen(path, "wb");
-  ASSERT(f != NULL);
-  ASSERT(fwrite(h, 1, hsize, f) == hsize);
-  unsigned char rec[80];
-  for (size_t i = 0; i < N; i++) {
-    for (unsigned j = 0; j < len; j++)
-      rec[j] = (unsigned char)(i * 31 + j);
-    for (int a = 0; a < 3; a++)
-      put(rec + 4 * a, (uint32_t)q[3 * i + a], 4);
-    ASSERT(fwrite(rec, 1, len, f) == len);
-  }
-  ASSERT(fclose(f) == 0);
-}
 
 int main(void) {
   double *xyz = malloc(3 * N * sizeof *xyz), *geo = malloc(3 * N * sizeof *geo);
@@ -80,13 +33,11 @@ int main(void) {
    * values LAS defines for its integers (two statements: no fma). */
   for (size_t i = 0; i < 3 * N; i++) {
     q[i] = (int32_t)lround(3 * xyz[i] / kScale + 1000 * (double)(i % 3));
-    double scaled = q[i] * kScale;
-    geo[i] = scaled + kOffset[i % 3];
+    geo[i] = las_value(q[i], kScale, kOffset[i % 3]);
   }
-  char dir[] = "/tmp/sc-las-recon-XXXXXX", ply[64], las[64], msg[256];
-  ASSERT(mkdtemp(dir) != NULL);
-  snprintf(ply, sizeof ply, "%s/torus.ply", dir);
-  snprintf(las, sizeof las, "%s/torus.las", dir);
+  tmp_init();
+  const char *ply = tmp_path("torus.ply"), *las = tmp_path("torus.las");
+  char msg[256];
   ASSERT_MSG(scf_mesh_write(ply, SCF_MESH_FMT_PLY_BINARY, geo, N, NULL, 0, NULL,
                             msg, sizeof msg) == 0,
              "%s", msg);
@@ -103,7 +54,19 @@ int main(void) {
              (int)ref->diag.closed, (unsigned long long)ref->diag.components,
              (long long)ref->diag.genus);
   for (unsigned format = 0; format <= 10; format++) {
-    write_las(las, q, format);
+    las_spec_t spec = {format >= 6 ? 4 : 2,
+                       format,
+                       0,
+                       0,
+                       0,
+                       {kScale, kScale, kScale},
+                       {kOffset[0], kOffset[1], kOffset[2]},
+                       N,
+                       q};
+    buf_t b;
+    las_build(&b, &spec);
+    buf_write(&b, las);
+    buf_free(&b);
     scf_points_t from_las;
     ASSERT_MSG(scf_points_read(las, &from_las, msg, sizeof msg) == 0,
                "format %u: %s", format, msg);
@@ -123,9 +86,6 @@ int main(void) {
   }
   sc_mesh_free(ref);
   scf_points_free(&from_ply);
-  unlink(ply);
-  unlink(las);
-  rmdir(dir);
   free(xyz);
   free(geo);
   free(q);

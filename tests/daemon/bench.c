@@ -413,10 +413,12 @@ int main(int argc, char **argv) {
     latency(points, repeat);
   if (!only || strcmp(only, "throughput") == 0)
     throughput(job_points, jobs, wmax, repeat);
+  int bad = 0;
   if (!only || strcmp(only, "round-trip") == 0)
-    bench_round_trip(shortcrust, points, repeat);
+    bad |= bench_round_trip(shortcrust, points, repeat);
   if (!only || strcmp(only, "streaming") == 0)
-    bench_streaming(shortcrust, stream_points, stream_seconds, repeat);
+    bad |= bench_streaming(shortcrust, stream_points, stream_seconds, repeat);
   scdt_cleanup(0);
-  return 0;
+  /* A wrong or missing mesh fails the run (and the smoke test). */
+  return bad;
 }

@@ -27,12 +27,13 @@ double bench_cpu_self(void);
 int bench_start(scdt_daemon_t *d, unsigned workers);
 
 /* `shortcrust submit` to a one-worker daemon against `shortcrust
- * reconstruct` of the same file, alternated, as whole processes. */
-void bench_round_trip(const char *shortcrust, size_t n, int repeat);
+ * reconstruct` of the same file, alternated, as whole processes. These two
+ * return 1 when a run failed or the meshes differ, else 0. */
+int bench_round_trip(const char *shortcrust, size_t n, int repeat);
 /* An upload paced over upload_s seconds, then JOB_END: the time to
  * JOB_DONE against `shortcrust reconstruct` of the same points, in random
  * and in scan order. */
-void bench_streaming(const char *shortcrust, size_t n, double upload_s,
-                     int repeat);
+int bench_streaming(const char *shortcrust, size_t n, double upload_s,
+                    int repeat);
 
 #endif

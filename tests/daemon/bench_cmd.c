@@ -90,7 +90,7 @@ static run_t reconstruct(const char *shortcrust, const char *in,
   return run(argv);
 }
 
-void bench_round_trip(const char *shortcrust, size_t n, int repeat) {
+int bench_round_trip(const char *shortcrust, size_t n, int repeat) {
   printf("round trip: `shortcrust submit` to a one-worker daemon against "
          "`shortcrust reconstruct`,\n  %zu points of a torus, whole "
          "processes, alternated\n",
@@ -147,6 +147,7 @@ void bench_round_trip(const char *shortcrust, size_t n, int repeat) {
   free(pair);
   free(lcpu);
   free(rcpu);
+  return failed || !identical;
 }
 
 /* Point orders of a streamed upload. */
@@ -242,8 +243,8 @@ static double paced_job(const char *sock, const double *xyz, size_t n,
   return t;
 }
 
-void bench_streaming(const char *shortcrust, size_t n, double upload_s,
-                     int repeat) {
+int bench_streaming(const char *shortcrust, size_t n, double upload_s,
+                    int repeat) {
   printf("streaming: %zu points of a torus uploaded over %.1f s, then "
          "JOB_END;\n  JOB_END to JOB_DONE against the whole `shortcrust "
          "reconstruct` of the same points\n",
@@ -263,6 +264,7 @@ void bench_streaming(const char *shortcrust, size_t n, double upload_s,
   double *tail = calloc((size_t)repeat, sizeof *tail);
   double *pair = calloc((size_t)repeat, sizeof *pair);
   double *took = calloc((size_t)repeat, sizeof *took);
+  int bad = 0;
   for (int order = ORDER_RANDOM; order <= ORDER_SCAN; order++) {
     reorder(xyz, n, order);
     if (write_points(in, xyz, n) != 0)
@@ -286,6 +288,7 @@ void bench_streaming(const char *shortcrust, size_t n, double upload_s,
            failed      ? "MISSING: a run failed"
            : identical ? "identical"
                        : "DIFFERENT");
+    bad |= failed || !identical;
   }
   scdt_daemon_stop(&d);
   free(xyz);
@@ -293,4 +296,5 @@ void bench_streaming(const char *shortcrust, size_t n, double upload_s,
   free(tail);
   free(pair);
   free(took);
+  return bad;
 }

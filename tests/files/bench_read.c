@@ -4,8 +4,9 @@
  * random cloud as binary PLY (x, y, z doubles), the same with normals and
  * colours (floats and uchars), LAS 1.4 formats 2 and 7 (with colours) and
  * text, then reads each with scf_points_read() and with
- * scf_points_read_attrs(), best of 3, and prints MB/s, points/s and the
- * bytes the properties take.
+ * scf_points_read_attrs(), best of 3, checking that each gives every
+ * point and property, and prints MB/s, points/s and the bytes the
+ * properties take.
  *
  *   shortcrust-read-bench [N] [DIR]
  *
@@ -21,6 +22,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "lasbuf.h"
 #include "shortcrust_files.h"
 
 static double now(void) {
@@ -37,54 +39,24 @@ static double uniform(void) {
   return (double)(rng >> 11) / 9007199254740992.0;
 }
 
-static void put(unsigned char *b, uint64_t v, int n) {
-  for (int i = 0; i < n; i++)
-    b[i] = (unsigned char)(v >> (8 * i));
+/* LAS 1.4 of the points, scale 0.001, offset 500000 4000000 100. */
+static void write_las(const char *path, const double *xyz, size_t n,
+                      unsigned format) {
+  int32_t *q = malloc(3 * n * sizeof *q);
+  if (q == NULL)
+    ASSERT_FAIL("out of memory");
+  for (size_t i = 0; i < 3 * n; i++)
+    q[i] = (int32_t)(xyz[i] * 1000);
+  las_spec_t spec = {
+      4, format, 0, 0, 0, {0.001, 0.001, 0.001}, {500000, 4000000, 100}, n, q};
+  buf_t b;
+  las_build(&b, &spec);
+  buf_write(&b, path);
+  buf_free(&b);
+  free(q);
 }
 
-/* LAS 1.4, point format 2 or 7, scale 0.001, offset 500000 4000000 100. */
-static int write_las(const char *path, const double *xyz, size_t n,
-                     int format) {
-  FILE *f = fopen(path, "wb");
-  if (f == NULL)
-    return -1;
-  unsigned char h[375];
-  memset(h, 0, sizeof h);
-  const unsigned len = format == 2 ? 26 : 36;
-  memcpy(h, "LASF", 4);
-  h[24] = 1;
-  h[25] = 4;
-  put(h + 94, sizeof h, 2);
-  put(h + 96, sizeof h, 4);
-  h[104] = (unsigned char)format;
-  put(h + 105, len, 2);
-  if (format < 6)
-    put(h + 107, n, 4);
-  put(h + 247, n, 8);
-  const double scale = 0.001, offset[3] = {500000, 4000000, 100};
-  for (int a = 0; a < 3; a++) {
-    uint64_t w;
-    memcpy(&w, &scale, 8);
-    put(h + 131 + 8 * a, w, 8);
-    memcpy(&w, &offset[a], 8);
-    put(h + 155 + 8 * a, w, 8);
-  }
-  fwrite(h, 1, sizeof h, f);
-  unsigned char rec[36];
-  for (size_t i = 0; i < n; i++) {
-    memset(rec, 0, sizeof rec);
-    for (int a = 0; a < 3; a++)
-      put(rec + 4 * a, (uint64_t)(int64_t)(xyz[3 * i + a] * 1000), 4);
-    put(rec + 12, i & 0xFFFF, 2);
-    const unsigned rgb = format == 2 ? 20 : 30;
-    for (int c = 0; c < 3; c++)
-      put(rec + rgb + 2 * c, (i * (c + 3)) & 0xFFFF, 2);
-    fwrite(rec, 1, len, f);
-  }
-  return fclose(f);
-}
-
-static int write_text(const char *path, const double *xyz, size_t n) {
+static int write_xyz(const char *path, const double *xyz, size_t n) {
   FILE *f = fopen(path, "w");
   if (f == NULL)
     return -1;
@@ -94,7 +66,10 @@ static int write_text(const char *path, const double *xyz, size_t n) {
   return fclose(f);
 }
 
-static void measure(const char *label, const char *path) {
+/* Times both reads of path, and checks that they give all n points and
+ * want_props properties. */
+static void measure(const char *label, const char *path, size_t n,
+                    size_t want_props) {
   struct stat st;
   if (stat(path, &st) != 0)
     return;
@@ -124,6 +99,11 @@ static void measure(const char *label, const char *path) {
       }
       scf_points_free(&p);
     }
+  if (points != n || props != want_props) {
+    fprintf(stderr, "%s: %zu points and %zu properties, expected %zu and %zu\n",
+            path, points, props, n, want_props);
+    exit(1);
+  }
   printf("%-28s %8.1f MB  x,y,z only %6.3f s %7.0f MB/s %5.1f Mpt/s   "
          "with %zu properties %6.3f s (%.2fx), +%.0f B/point\n",
          label, mb, best[0], mb / best[0], (double)points / best[0] / 1e6,
@@ -172,16 +152,17 @@ int main(int argc, char **argv) {
                      sizeof msg) != 0 ||
       scf_mesh_write_attrs(p2, SCF_MESH_FMT_PLY_BINARY, xyz, n, NULL, 0, NULL,
                            &a, msg, sizeof msg) != 0 ||
-      write_las(p3, xyz, n, 2) != 0 || write_las(p4, xyz, n, 7) != 0 ||
-      write_text(p5, xyz, n) != 0) {
+      write_xyz(p5, xyz, n) != 0) {
     fprintf(stderr, "writing failed: %s\n", msg);
     return 1;
   }
-  measure("binary PLY x,y,z", p1);
-  measure("binary PLY + normals, rgb", p2);
-  measure("LAS 1.4 format 2 (rgb)", p3);
-  measure("LAS 1.4 format 7 (gps, rgb)", p4);
-  measure("text x y z", p5);
+  write_las(p3, xyz, n, 2);
+  write_las(p4, xyz, n, 7);
+  measure("binary PLY x,y,z", p1, n, 0);
+  measure("binary PLY + normals, rgb", p2, n, 6);
+  measure("LAS 1.4 format 2 (rgb)", p3, n, 7);
+  measure("LAS 1.4 format 7 (gps, rgb)", p4, n, 8);
+  measure("text x y z", p5, n, 0);
   if (argc <= 2) {
     unlink(p1);
     unlink(p2);
