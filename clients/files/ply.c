@@ -10,6 +10,7 @@
  */
 #include "scf_internal.h"
 
+#include <math.h>
 #include <stdio.h>
 
 typedef enum ply_type {
@@ -101,26 +102,27 @@ static void ply_put_attr(unsigned char *dst, const unsigned char *src,
     dst[i] = big_endian ? src[sz - 1 - i] : src[i];
 }
 
-/* The same from the number an ascii file gave. */
-static void ply_put_attr_number(unsigned char *dst, double d, ply_type_t t) {
+/* The same from the number an ascii file gave: 0, or -1 when an integer
+ * type cannot hold it (not a whole number, or out of the type's range). */
+static int ply_put_attr_number(unsigned char *dst, double d, ply_type_t t) {
+  static const double lo[] = {0, -128, 0, -32768, 0, -2147483648.0, 0};
+  static const double hi[] = {0,     127,          255,         32767,
+                              65535, 2147483647.0, 4294967295.0};
   unsigned char b[8];
-  switch (t) {
-  case PT_F32:
+  if (t == PT_F32) {
     scf__put_f32le(b, (float)d);
-    break;
-  case PT_F64:
+  } else if (t == PT_F64) {
     scf__put_f64le(b, d);
-    break;
-  default: {
-    /* Integers: the value's low bytes, two's complement. */
+  } else {
+    if (!(d >= lo[t] && d <= hi[t]) || d != floor(d))
+      return -1;
+    /* Two's complement, low bytes first. */
     uint64_t u = (uint64_t)(int64_t)d;
-    if (d >= 9223372036854775808.0)
-      u = (uint64_t)d;
     for (int i = 0; i < 8; i++)
       b[i] = (unsigned char)(u >> (8 * i));
   }
-  }
   memcpy(dst, b, ply_type_size(t));
+  return 0;
 }
 
 static void ply_free(ply_t *p) {
@@ -615,9 +617,16 @@ static int ply_ascii_elem(tokens_t *ts, const ply_t *p, size_t ei,
             xyz[1] = d;
           else if ((int)j == p->pz)
             xyz[2] = d;
-          else if (p->amap != NULL && p->amap[j] >= 0)
-            ply_put_attr_number(arec + v->attrs->props[p->amap[j]].offset, d,
-                                pp->type);
+          else if (p->amap != NULL && p->amap[j] >= 0 &&
+                   ply_put_attr_number(
+                       arec + v->attrs->props[p->amap[j]].offset, d, pp->type) <
+                       0)
+            return scf__rd_fail_line(r, r->line, SCF_EFORMAT,
+                                     "'%s' does not fit property '%s' (%s) "
+                                     "of %s %llu",
+                                     scf__show(tok, buf), pp->name,
+                                     scf_type_name(ply_scf_type(pp->type)),
+                                     e->name, (scf__ull)k);
         }
         continue;
       }
