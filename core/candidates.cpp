@@ -89,7 +89,8 @@ bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles,
 template <class DT>
 void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
                        const sc_params_t &params, Progress &progress,
-                       std::vector<uint32_t> &tris, sc_diag_t &diag) {
+                       std::vector<uint32_t> &tris, sc_diag_t &diag,
+                       const Ownership *own) {
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
   Criteria cr(params);
@@ -119,9 +120,22 @@ void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
   // Facet f of the cell loaded, whose dual Voronoi edge runs from its
   // circumcentre to `other`, or leaves the hull outward when `ray`.
   auto facet = [&](int f, V3 other, bool ray) {
+    // The corners in the order of their vertex numbers: how a cell orders
+    // its vertices depends on the order of insertion, and the rounding of
+    // the tests on the order of the corners; this way a facet gets the same
+    // answer whichever of its cells, and whichever triangulation (one, or a
+    // tile's), reports it.
+    int ci[3] = {(f + 1) % 4, (f + 2) % 4, (f + 3) % 4};
+    auto order = [&](int a, int b) {
+      if (Cidx[ci[b]] < Cidx[ci[a]])
+        std::swap(ci[a], ci[b]);
+    };
+    order(0, 1), order(1, 2), order(0, 1);
+    if (own && !(*own)(Cidx[ci[0]]))
+      return;
     ++diag.delaunay_facets;
     for (int j = 0; j < 3; ++j) {
-      const int i = (f + 1 + j) % 4;
+      const int i = ci[j];
       P[j] = CP[i];
       poles[j] = Cpoles[i];
       idx[j] = Cidx[i];
@@ -169,12 +183,14 @@ void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
 template void select_candidates<DtSeq>(DtSeq &,
                                        std::vector<DtSeq::Cell_handle> &,
                                        const sc_params_t &, Progress &,
-                                       std::vector<uint32_t> &, sc_diag_t &);
+                                       std::vector<uint32_t> &, sc_diag_t &,
+                                       const Ownership *);
 #ifdef CGAL_LINKED_WITH_TBB
 template void select_candidates<DtPar>(DtPar &,
                                        std::vector<DtPar::Cell_handle> &,
                                        const sc_params_t &, Progress &,
-                                       std::vector<uint32_t> &, sc_diag_t &);
+                                       std::vector<uint32_t> &, sc_diag_t &,
+                                       const Ownership *);
 #endif
 
 } // namespace dt

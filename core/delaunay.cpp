@@ -39,13 +39,15 @@ struct XyzMap {
   }
 };
 
-// Sorts point indices along a Hilbert curve of their points (CGAL's median
-// policy).
+} // namespace
+
 void hilbert_sort(const double *xyz, std::vector<uint32_t> &idx) {
   CGAL::hilbert_sort(idx.begin(), idx.end(),
                      CGAL::Spatial_sort_traits_adapter_3<K, XyzMap>(
                          XyzMap{xyz}));
 }
+
+namespace {
 
 // The round of point i in a biased randomized insertion order: r with
 // probability 3/4^(r+1), from a hash of the index (splitmix64's finaliser),
@@ -150,6 +152,24 @@ private:
   size_t used_ = 0, built_for_ = 0;
 };
 
+} // namespace
+
+std::vector<uint32_t> brio_order(const std::vector<uint32_t> &hilbert) {
+  // A counting sort by round, the last (largest) round last: bucket
+  // kRounds - r, of kRounds + 1, starts at start[kRounds - r].
+  std::array<size_t, kRounds + 2> start{};
+  for (uint32_t i : hilbert)
+    ++start[size_t(kRounds - brio_round(i)) + 1];
+  for (int b = 0; b <= kRounds; ++b)
+    start[size_t(b) + 1] += start[size_t(b)];
+  std::vector<uint32_t> brio(hilbert.size());
+  for (uint32_t i : hilbert)
+    brio[start[size_t(kRounds - brio_round(i))]++] = i;
+  return brio;
+}
+
+namespace {
+
 template <class DT> class TriangulatorImpl : public Triangulator {
 public:
   template <class... A> explicit TriangulatorImpl(A &&...a) : dt_(a...) {}
@@ -168,7 +188,7 @@ public:
     std::vector<uint32_t> order(n);
     std::iota(order.begin(), order.end(), uint32_t(first));
     hilbert_sort(xyz, order);
-    std::vector<uint32_t> brio(n);
+    std::vector<uint32_t> brio;
     // A chunk that comes after at least as many points lands in a
     // triangulation that already spans its region: there the rounds only
     // make the walk from one point to the next longer, and the plain
@@ -179,15 +199,7 @@ public:
     if (append) {
       brio = order;
     } else {
-      // A counting sort by round, the last (largest) round last: bucket
-      // kRounds - r, of kRounds + 1, starts at start[kRounds - r].
-      std::array<size_t, kRounds + 2> start{};
-      for (uint32_t i : order)
-        ++start[size_t(kRounds - brio_round(i)) + 1];
-      for (int b = 0; b <= kRounds; ++b)
-        start[size_t(b) + 1] += start[size_t(b)];
-      for (uint32_t i : order)
-        brio[start[size_t(kRounds - brio_round(i))]++] = i;
+      brio = brio_order(order);
     }
     if (first == 0)
       hilbert_.swap(order);

@@ -220,15 +220,37 @@ void for_cells(DT &dt, bool neighbours, Visit &&visit) {
   }
 }
 
+// Sorts point indices along a Hilbert curve of their points (CGAL's median
+// policy).
+void hilbert_sort(const double *xyz, std::vector<uint32_t> &idx);
+// A biased randomized insertion order (Amenta, Choi and Rote) drawn from a
+// Hilbert order of the indices: rounds, each a quarter of the size of the
+// next, each in Hilbert order (delaunay.cpp).
+std::vector<uint32_t> brio_order(const std::vector<uint32_t> &hilbert);
+
+// Which vertices a tile of a tiled filtering owns (tiles.cpp): by vertex
+// number, the tile of each. A tile counts, and decides, only what belongs
+// to it: a cell or a facet belongs to the tile of its lowest-numbered
+// vertex. Null for the whole triangulation.
+struct Ownership {
+  const uint16_t *owner;
+  uint16_t tile;
+  bool operator()(uint32_t vertex) const { return owner[vertex] == tile; }
+};
+
 // The stages, in the order delaunay.cpp runs them; each is instantiated for
 // the sequential and the parallel triangulation in its own file.
 
 // Poles (poles.cpp): each vertex's pole direction, unit, and each finite
 // cell's circumcentre (CellData::cc); infinite receives the infinite cells,
 // marked as such, for the stages after.
+// With own, the counts in diag are of what the tile owns, and the poles
+// of its own vertices are the whole triangulation's when every cell around
+// them is (tiles.cpp); the others' are not used.
 template <class DT>
 void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
-                   Progress &progress, sc_diag_t &diag);
+                   Progress &progress, sc_diag_t &diag,
+                   const Ownership *own = nullptr);
 
 // Boundary detection (boundary.cpp), after the poles: marks the interior
 // samples (kVInterior) and fills boundary by vertex number (or leaves it
@@ -240,10 +262,12 @@ void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
 
 // The candidate triangles (candidates.cpp), by vertex number, from the one
 // pass over the Delaunay facets; frees infinite.
+// With own, only the facets the tile owns are tested and counted.
 template <class DT>
 void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
                        const sc_params_t &params, Progress &progress,
-                       std::vector<uint32_t> &tris, sc_diag_t &diag);
+                       std::vector<uint32_t> &tris, sc_diag_t &diag,
+                       const Ownership *own = nullptr);
 
 // Watertight mode's labelling of the cells (labels.cpp): see
 // Triangulator::close().

@@ -70,7 +70,7 @@ V3 centre(typename DT::Cell_handle c, sc_diag_t *diag) {
 
 template <class DT>
 void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
-                   Progress &progress, sc_diag_t &diag) {
+                   Progress &progress, sc_diag_t &diag, const Ownership *own) {
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
   const float kHull = std::numeric_limits<float>::infinity();
@@ -78,12 +78,23 @@ void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
   // Samples on the convex hull: the pole is at infinity, in the direction
   // of the average outward normal of the hull facets around them. The
   // infinite cells are kept for boundary detection and the candidates.
+  // A cell, or a facet of the hull, belongs to a tile by its
+  // lowest-numbered vertex.
+  auto owns = [own](Ch c, int skip) {
+    if (!own)
+      return true;
+    uint32_t low = UINT32_MAX;
+    for (int j = 0; j < 4; ++j)
+      if (j != skip)
+        low = std::min(low, c->vertex(j)->info().idx);
+    return (*own)(low);
+  };
   infinite.clear();
   dt.incident_cells(dt.infinite_vertex(), std::back_inserter(infinite));
-  diag.hull_facets = infinite.size();
   for (Ch c : infinite) {
     c->info().mark_infinite();
     int inf = c->index(dt.infinite_vertex());
+    diag.hull_facets += owns(c, inf);
     V3 pts[3];
     V3 nrm = hull_normal(c, inf, pts);
     // On a grid of 2^-30: sums of such numbers are exact, so they do not
@@ -102,8 +113,9 @@ void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
   size_t cells = dt.number_of_cells(), k = 0;
   for_cells(dt, false, [&](auto c) {
     progress.tick(k++, cells);
-    ++diag.delaunay_cells;
-    V3 cc = centre<DT>(c, &diag);
+    const bool mine = owns(c, -1);
+    diag.delaunay_cells += mine;
+    V3 cc = centre<DT>(c, mine ? &diag : nullptr);
     c->info().cc[0] = float(cc.x), c->info().cc[1] = float(cc.y),
     c->info().cc[2] = float(cc.z);
     for (int j = 0; j < 4; ++j) {
@@ -130,7 +142,7 @@ void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
   for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end();
        ++v) {
     VertexData &d = v->info();
-    if (d.best == kHull)
+    if (d.best == kHull && (!own || (*own)(d.idx)))
       ++diag.hull_vertices;
     double l = std::sqrt(d.pole[0] * d.pole[0] + d.pole[1] * d.pole[1] +
                          d.pole[2] * d.pole[2]);
@@ -140,10 +152,10 @@ void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
 }
 
 template void compute_poles<DtSeq>(DtSeq &, std::vector<DtSeq::Cell_handle> &,
-                                   Progress &, sc_diag_t &);
+                                   Progress &, sc_diag_t &, const Ownership *);
 #ifdef CGAL_LINKED_WITH_TBB
 template void compute_poles<DtPar>(DtPar &, std::vector<DtPar::Cell_handle> &,
-                                   Progress &, sc_diag_t &);
+                                   Progress &, sc_diag_t &, const Ownership *);
 #endif
 
 } // namespace dt

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <new>
+#include <thread>
 
 namespace sc {
 
@@ -231,7 +232,21 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
 // needs every point. (Auto mode's choice needs them too: points that come
 // in chunks are inserted as they come, and inserted again, smoothed, only
 // if the estimate finds noise.)
-bool Recon::defer_insertion() const { return params_.denoise != 0; }
+bool Recon::defer_insertion() const {
+  return params_.denoise != 0 || tile_count() != 0;
+}
+
+// The boundary modes classify samples over the whole triangulation, and
+// run on one.
+size_t Recon::tile_count() const {
+  if (params_.tiles == 1 || detects_boundary(params_.mode))
+    return 0;
+  const unsigned threads =
+      params_.threads > 0 ? unsigned(params_.threads)
+                          : std::max(1u, std::thread::hardware_concurrency());
+  const size_t k = params_.tiles > 0 ? size_t(params_.tiles) : threads;
+  return k >= 2 ? k : 0;
+}
 
 // Estimates the noise and, when denoising, smooths a copy of the points;
 // work_ is then the points to triangulate (sections 16.1 to 16.3).
@@ -310,7 +325,8 @@ void Recon::borrow(const double *xyz, size_t n) {
   n_ = n;
   seconds_[SC_STAGE_INPUT] += sw.lap();
   prepare(progress);
-  insert_range(work_, 0, n);
+  if (!tile_count())
+    insert_range(work_, 0, n);
 }
 
 namespace {
@@ -487,18 +503,26 @@ sc_mesh_t *Recon::finish() {
   diag.denoise_scale = smoothing_.scale;
   diag.denoise_shift = smoothing_.shift;
   diag.seconds_denoise = seconds_denoise_;
-  if (!dt_)
-    insert_range(work, 0, n_);
-  check_spread(n_, dt_.get());
-  // Points inserted as they came are in the caller's frame: moved with
-  // the rest, exactly.
-  if (dt_raw_ && !shifted_.empty())
-    dt_->translate(shift_);
-
   Filtered f;
+  // Tiles (section 17) hold each point near their region from the start:
+  // the points within a few spacings.
+  const bool tiled = !dt_ && tile_count() &&
+                     dt::tiled_filter(work, n_, tile_count(), params_.threads,
+                                      3 * noise_.spacing, params_, progress, f,
+                                      diag, seconds_);
+  if (!tiled) {
+    f = Filtered();
+    if (!dt_)
+      insert_range(work, 0, n_);
+    check_spread(n_, dt_.get());
+    // Points inserted as they came are in the caller's frame: moved with
+    // the rest, exactly.
+    if (dt_raw_ && !shifted_.empty())
+      dt_->translate(shift_);
+    dt_->filter(work, n_, params_, progress, f, diag, seconds_);
+    dt_.reset();
+  }
   const bool watertight = params_.mode == SC_MODE_WATERTIGHT;
-  dt_->filter(work, n_, params_, progress, f, diag, seconds_);
-  dt_.reset();
   diag.path = params_.mode == SC_MODE_SHORTCRUST ? SC_PATH_SHORTCRUST
               : params_.mode == SC_MODE_COCONE   ? SC_PATH_COCONE
                                                  : SC_PATH_BOUNDARY;

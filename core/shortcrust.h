@@ -159,7 +159,15 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *  - max_hole_edges: holes whose boundary loop has at most this many edges
  *    are closed after extraction by a least-area triangulation of the loop;
  *    0 disables.
- *  - threads: threads of the Delaunay triangulation; 0 means one per core.
+ *  - threads: threads of the reconstruction; 0 means one per core. With
+ *    one tile, CGAL's parallel triangulation runs on them; with several,
+ *    the tiles do.
+ *  - tiles (cocone and shortcrust modes; the others run one
+ *    triangulation): the points are split into this many tiles whose
+ *    triangulations are certified against each other, so that the mesh is
+ *    the one a single triangulation gives, triangle for triangle
+ *    (docs/algorithm.md section 17). 1, the default, never tiles; 0 means
+ *    one per thread.
  *  - boundary_rho (boundary, watertight and auto modes): a sample passes
  *    the ratio test when the farthest Voronoi vertex of its cell inside its
  *    cocone is at most boundary_rho times the distance to its negative
@@ -190,7 +198,7 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
 #define SC_PARAM_MAP(X)                                                        \
   X(mode, sc_mode_t, MODE, SC_MODE_COCONE, 0, SC_MODE_COUNT_ - 1,              \
     SC_RANGE_CLOSED, "a mode", FIXED, 'm', "mode", "MODE",                     \
-    "cocone, shortcrust, boundary (scans with a boundary), watertight "       \
+    "cocone, shortcrust, boundary (scans with a boundary), watertight "        \
     "(close every hole) or auto")                                              \
   X(r, double, REAL, 0.18, 0, 0.5, SC_RANGE_OPEN, "in (0, 0.5)", FIXED, 0,     \
     "r", "R", "shortcrust sampling parameter")                                 \
@@ -204,7 +212,12 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "close holes of at most N edges, 0 = never")                               \
   X(threads, int, INT, 1, 0, 1024, SC_RANGE_CLOSED, "in [0, 1024]", LOCAL,     \
     'j', "threads", "N",                                                       \
-    "threads for the Delaunay triangulation, 0 = one per core")                \
+    "threads for the Delaunay triangulation, or for the tiles, 0 = one per "   \
+    "core")                                                                    \
+  X(tiles, int, INT, 1, 0, 4096, SC_RANGE_CLOSED, "in [0, 4096]", LOCAL, 0,    \
+    "tiles", "N",                                                              \
+    "split the points into N tiles triangulated apart, on the threads; the "   \
+    "same mesh whatever N; 0 = one per thread (cocone and shortcrust modes)")  \
   X(boundary_rho, double, REAL, 1.3, 0, 10,                                    \
     SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "in (0, 10]", OPTION, 0, "rho",  \
     "RHO", "boundary detection: ratio of cocone extent to pole height")        \
@@ -214,18 +227,18 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "boundary detection: largest angle between neighbouring poles")            \
   X(watertight_labels, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION,  \
     0, "labels", NULL,                                                         \
-    "watertight mode: close the surface by labelling Delaunay cells inside "  \
-    "or outside first (default: least-area patches first, labelling where "   \
+    "watertight mode: close the surface by labelling Delaunay cells inside "   \
+    "or outside first (default: least-area patches first, labelling where "    \
     "they cannot close it)")                                                   \
   X(denoise, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION, 0,         \
     "denoise", NULL,                                                           \
-    "smooth a copy of the points toward the surface and reconstruct on it; "  \
-    "the triangles still join the original samples")                          \
+    "smooth a copy of the points toward the surface and reconstruct on it; "   \
+    "the triangles still join the original samples")                           \
   X(denoise_scale, double, REAL, 0, 0, 1e300,                                  \
     SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "positive", OPTION, 0,           \
     "denoise-scale", "S",                                                      \
-    "denoising: radius of the smoothing neighbourhood, in the input's units " \
-    "(default: estimated); given, it smooths whatever the noise")             \
+    "denoising: radius of the smoothing neighbourhood, in the input's units "  \
+    "(default: estimated); given, it smooths whatever the noise")              \
   X(smoothed_vertices, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION,  \
     0, "smoothed-vertices", NULL,                                              \
     "denoising: give the mesh the smoothed positions of the samples instead "  \
@@ -315,8 +328,7 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
   X(delaunay_vertices, uint64_t, , COUNT, "delaunay_vertices",                 \
     "distinct points in the triangulation")                                    \
   X(delaunay_cells, uint64_t, , COUNT, "delaunay_cells", "finite tetrahedra")  \
-  X(delaunay_facets, uint64_t, , COUNT, "delaunay_facets",                     \
-    "finite triangles")                                                        \
+  X(delaunay_facets, uint64_t, , COUNT, "delaunay_facets", "finite triangles") \
   X(hull_vertices, uint64_t, , COUNT, "hull_vertices",                         \
     "samples on the convex hull")                                              \
   X(degenerate_cells, uint64_t, , COUNT, "degenerate_cells",                   \
@@ -359,7 +371,7 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
   X(seconds_total, double, , SECONDS, "seconds.total",                         \
     "wall time of the whole reconstruction, in seconds")                       \
   X(path, int, , PATH, "path",                                                 \
-    "the path taken: what auto mode chose, and how watertight mode closed "   \
+    "the path taken: what auto mode chose, and how watertight mode closed "    \
     "the surface (the SC_PATH_ values)")                                       \
   X(boundary_samples, uint64_t, , COUNT, "boundary_samples",                   \
     "samples found not interior (0 in the shortcrust and cocone modes)")       \
@@ -372,31 +384,35 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
   X(bubbles_dropped, uint64_t, , COUNT, "bubbles_dropped",                     \
     "small closed components removed (boundary, watertight and auto modes)")   \
   X(samples_attached, uint64_t, , COUNT, "samples_attached",                   \
-    "samples left out by extraction, then inserted into the nearest "         \
+    "samples left out by extraction, then inserted into the nearest "          \
     "triangle")                                                                \
   X(handles_cut, uint64_t, , COUNT, "handles_cut",                             \
     "watertight: handles that closed round a hole, cut before closing")        \
   X(hull_facets, uint64_t, , COUNT, "hull_facets",                             \
     "triangles of the convex hull")                                            \
   X(spacing, double, , REAL, "spacing",                                        \
-    "estimated sample spacing, in the input's units")                         \
+    "estimated sample spacing, in the input's units")                          \
   X(noise, double, , REAL, "noise",                                            \
-    "estimated noise: RMS distance of the samples to their local surface, in "\
+    "estimated noise: RMS distance of the samples to their local surface, in " \
     "spacings")                                                                \
   X(curvature, double, , REAL, "curvature",                                    \
     "median of the local surface's larger curvature times the spacing; above " \
     "0.15 + noise / 2 the sample is too coarse to tell noise, and denoising "  \
     "does not smooth")                                                         \
   X(denoised, int, , BOOL, "denoised",                                         \
-    "1 when the surface was reconstructed on a smoothed copy of the points")  \
+    "1 when the surface was reconstructed on a smoothed copy of the points")   \
   X(denoise_scale, double, , REAL, "denoise_scale",                            \
-    "the smoothing neighbourhood's radius, in the input's units (0 without "  \
+    "the smoothing neighbourhood's radius, in the input's units (0 without "   \
     "denoising)")                                                              \
   X(denoise_shift, double, , REAL, "denoise_shift",                            \
-    "RMS distance the smoothing moved the samples, in spacings")              \
+    "RMS distance the smoothing moved the samples, in spacings")               \
   X(seconds_denoise, double, , SECONDS, "seconds.denoise",                     \
     "wall time of the noise estimate and the smoothing, in seconds (part of "  \
-    "the input stage)")
+    "the input stage)")                                                        \
+  X(tiles, uint64_t, , COUNT, "tiles",                                         \
+    "tiles the points were split into (0: one triangulation of all)")          \
+  X(tile_points_foreign, uint64_t, , COUNT, "tile_points_foreign",             \
+    "points triangulated in a tile besides its own: the tiles' overhead")
 
 typedef struct sc_diag {
 #define SC_DIAG_FIELD_(field, type, dim, kind, wire, help) type field dim;

@@ -1,0 +1,730 @@
+// Tiled filtering (docs/algorithm.md section 17): the points split into
+// tiles that are triangulated apart, on threads, each grown with the points
+// of its neighbours until every Delaunay cell around its own samples is
+// certified to be a cell of the triangulation of all the points. The poles
+// of a tile's samples and the candidate test of the facets it owns are then
+// exactly those of the single triangulation, and so is the mesh.
+//
+// SPDX-License-Identifier: GPL-3.0-or-later
+
+#include "delaunay.hpp"
+
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <cstring>
+#include <exception>
+#include <mutex>
+#include <numeric>
+#include <thread>
+
+namespace sc {
+namespace dt {
+namespace {
+
+typedef DtSeq::Vertex_handle Vh;
+typedef DtSeq::Cell_handle Ch;
+typedef CGAL::Exact_predicates_exact_constructions_kernel Exact;
+
+// A tile smaller than this is not worth a triangulation of its own.
+constexpr size_t kMinTilePoints = 2000;
+// VertexData::flags while a tile's own points go in: the vertex has an
+// index.
+constexpr uint8_t kSeen = 0x80;
+// CellData while the tiles are certified (the poles stage writes the
+// circumcentre over it): the cell was checked, a NaN no arithmetic gives.
+constexpr uint32_t kChecked = 0x7fc5a5a6u;
+
+// A static k-d tree over the distinct points, by vertex number: which
+// points lie in a ball. Read by every tile's thread at once; nothing in it
+// changes after construction.
+class PointTree {
+public:
+  PointTree(const double *pts, size_t m) : pts_(pts), idx_(m) {
+    std::iota(idx_.begin(), idx_.end(), 0u);
+    if (m)
+      build(0, m);
+  }
+  // Calls f(v) for every point v within distance sqrt(r2) of c (and maybe a
+  // few more: f decides), except in parts of the tree whose box lies
+  // inside `skip`.
+  template <class F>
+  void in_ball(const double c[3], double r2, const double skip_lo[3],
+               const double skip_hi[3], F &&f) const {
+    if (!nodes_.empty())
+      visit(0, c, r2, skip_lo, skip_hi, f);
+  }
+
+  // Calls f(v) for every point v on the outer side of the plane through a
+  // with normal nrm, or within tol of it (and maybe a few more), except in
+  // parts of the tree whose box lies inside `skip`.
+  template <class F>
+  void beyond(const double a[3], const double nrm[3], double tol,
+              const double skip_lo[3], const double skip_hi[3], F &&f) const {
+    if (!nodes_.empty())
+      visit_beyond(0, a, nrm, tol, skip_lo, skip_hi, f);
+  }
+  // The length of the diagonal of the box of all the points.
+  double extent() const {
+    if (nodes_.empty())
+      return 0;
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a)
+      d2 += (nodes_[0].hi[a] - nodes_[0].lo[a]) *
+            (nodes_[0].hi[a] - nodes_[0].lo[a]);
+    return std::sqrt(d2);
+  }
+
+private:
+  static constexpr size_t kLeaf = 8;
+
+  template <class F>
+  void visit_beyond(int32_t id, const double a[3], const double nrm[3],
+                    double tol, const double skip_lo[3],
+                    const double skip_hi[3], F &f) const {
+    const Node &nd = nodes_[size_t(id)];
+    double top = 0;
+    bool inside = true;
+    for (int k = 0; k < 3; ++k) {
+      top += nrm[k] * ((nrm[k] > 0 ? nd.hi[k] : nd.lo[k]) - a[k]);
+      inside = inside && nd.lo[k] >= skip_lo[k] && nd.hi[k] <= skip_hi[k];
+    }
+    if (top < -tol || inside)
+      return;
+    if (nd.left < 0) {
+      for (uint32_t i = nd.begin; i < nd.end; ++i) {
+        const double *p = pts_ + 3 * size_t(idx_[i]);
+        if (nrm[0] * (p[0] - a[0]) + nrm[1] * (p[1] - a[1]) +
+                nrm[2] * (p[2] - a[2]) >=
+            -tol)
+          f(idx_[i]);
+      }
+      return;
+    }
+    visit_beyond(nd.left, a, nrm, tol, skip_lo, skip_hi, f);
+    visit_beyond(nd.right, a, nrm, tol, skip_lo, skip_hi, f);
+  }
+  struct Node {
+    double lo[3], hi[3];
+    uint32_t begin, end;
+    int32_t left = -1, right = -1;
+  };
+
+  int32_t build(size_t b, size_t e) {
+    const int32_t id = int32_t(nodes_.size());
+    nodes_.push_back(Node());
+    Node nd;
+    for (int a = 0; a < 3; ++a)
+      nd.lo[a] = HUGE_VAL, nd.hi[a] = -HUGE_VAL;
+    for (size_t i = b; i < e; ++i)
+      for (int a = 0; a < 3; ++a) {
+        const double x = pts_[3 * size_t(idx_[i]) + a];
+        nd.lo[a] = std::min(nd.lo[a], x);
+        nd.hi[a] = std::max(nd.hi[a], x);
+      }
+    nd.begin = uint32_t(b), nd.end = uint32_t(e);
+    if (e - b > kLeaf) {
+      int axis = 0;
+      for (int a = 1; a < 3; ++a)
+        if (nd.hi[a] - nd.lo[a] > nd.hi[axis] - nd.lo[axis])
+          axis = a;
+      const size_t mid = b + (e - b) / 2;
+      std::nth_element(idx_.begin() + long(b), idx_.begin() + long(mid),
+                       idx_.begin() + long(e), [&](uint32_t p, uint32_t q) {
+                         return pts_[3 * size_t(p) + axis] <
+                                pts_[3 * size_t(q) + axis];
+                       });
+      nd.left = build(b, mid);
+      nd.right = build(mid, e);
+    }
+    nodes_[size_t(id)] = nd;
+    return id;
+  }
+
+  template <class F>
+  void visit(int32_t id, const double c[3], double r2, const double skip_lo[3],
+             const double skip_hi[3], F &f) const {
+    const Node &nd = nodes_[size_t(id)];
+    double d2 = 0;
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) {
+      const double d = c[a] < nd.lo[a]   ? nd.lo[a] - c[a]
+                       : c[a] > nd.hi[a] ? c[a] - nd.hi[a]
+                                         : 0.0;
+      d2 += d * d;
+      inside = inside && nd.lo[a] >= skip_lo[a] && nd.hi[a] <= skip_hi[a];
+    }
+    if (d2 > r2 || inside)
+      return;
+    if (nd.left < 0) {
+      for (uint32_t i = nd.begin; i < nd.end; ++i) {
+        const double *p = pts_ + 3 * size_t(idx_[i]);
+        const double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
+        if (dx * dx + dy * dy + dz * dz <= r2)
+          f(idx_[i]);
+      }
+      return;
+    }
+    visit(nd.left, c, r2, skip_lo, skip_hi, f);
+    visit(nd.right, c, r2, skip_lo, skip_hi, f);
+  }
+
+  const double *pts_;
+  std::vector<uint32_t> idx_;
+  std::vector<Node> nodes_;
+};
+
+// A box; a side at infinity where the tile reaches the outside.
+struct Box {
+  double lo[3], hi[3];
+};
+
+struct Tile {
+  uint16_t id = 0;
+  Box region;                // the space whose points the tile owns
+  Box reach;                 // region grown by the margin: all points in it
+  std::vector<uint32_t> own; // input indices, ascending
+  DtSeq dt;
+  std::vector<std::pair<uint32_t, uint32_t>> dups; // (duplicate, first)
+  std::vector<uint8_t> member; // by vertex number: foreign and inserted
+  std::vector<Ch> infinite;
+  std::vector<uint32_t> tris;
+  sc_diag_t diag;
+  size_t foreign = 0, rounds = 0, checked = 0;
+  Tile() { std::memset(&diag, 0, sizeof diag); }
+};
+
+// Splits idx[b, e) (input indices) into k tiles by counts: at the median
+// of the longest side of the points' box, points below the splitting value
+// on one side and the others (equal points too, so that duplicates stay
+// together) on the other.
+void split(const double *xyz, std::vector<uint32_t> &idx, size_t b, size_t e,
+           size_t k, const Box &region, std::vector<Tile> &tiles) {
+  auto leaf = [&] {
+    tiles.emplace_back();
+    Tile &t = tiles.back();
+    t.region = region;
+    t.own.assign(idx.begin() + long(b), idx.begin() + long(e));
+    std::sort(t.own.begin(), t.own.end());
+  };
+  if (k <= 1 || e - b < 2 * kMinTilePoints) {
+    leaf();
+    return;
+  }
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+         hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (size_t i = b; i < e; ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], xyz[3 * size_t(idx[i]) + a]);
+      hi[a] = std::max(hi[a], xyz[3 * size_t(idx[i]) + a]);
+    }
+  int axes[3] = {0, 1, 2};
+  std::sort(axes, axes + 3,
+            [&](int p, int q) { return hi[p] - lo[p] > hi[q] - lo[q]; });
+  const size_t kl = k / 2;
+  for (int axis : axes) {
+    auto coord = [&](uint32_t i) { return xyz[3 * size_t(i) + axis]; };
+    const size_t want = b + (e - b) * kl / k;
+    std::nth_element(
+        idx.begin() + long(b), idx.begin() + long(want), idx.begin() + long(e),
+        [&](uint32_t p, uint32_t q) { return coord(p) < coord(q); });
+    const double s = coord(idx[want]);
+    const size_t mid =
+        size_t(std::partition(idx.begin() + long(b), idx.begin() + long(e),
+                              [&](uint32_t i) { return coord(i) < s; }) -
+               idx.begin());
+    if (mid - b < kMinTilePoints || e - mid < kMinTilePoints)
+      continue;
+    Box left = region, right = region;
+    left.hi[axis] = s;
+    right.lo[axis] = s;
+    split(xyz, idx, b, mid, kl, left, tiles);
+    split(xyz, idx, mid, e, k - kl, right, tiles);
+    return;
+  }
+  leaf();
+}
+
+// Whether p lies in box (closed).
+inline bool in_box(const Box &box, const double *p) {
+  for (int a = 0; a < 3; ++a)
+    if (!(p[a] >= box.lo[a] && p[a] <= box.hi[a]))
+      return false;
+  return true;
+}
+
+// Runs fn(i, progress) for every tile i on `threads` threads while this
+// thread reports progress (done tiles of all) and watches for a cancel: a
+// cancel, or an error on any thread, stops the others at their next
+// progress tick, and is rethrown here once they have all stopped.
+template <class F>
+void run_tiles(size_t k, unsigned threads, Progress &progress, F &&fn) {
+  std::atomic<size_t> next{0}, done{0};
+  std::atomic<int> stop{0};
+  std::exception_ptr error;
+  std::mutex mu;
+  std::condition_variable cv;
+  auto worker = [&] {
+    Progress mine(
+        [](void *u, sc_stage_t, double) {
+          return static_cast<std::atomic<int> *>(u)->load();
+        },
+        &stop);
+    for (;;) {
+      const size_t i = next++;
+      if (i >= k || stop.load())
+        break;
+      try {
+        fn(i, mine);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mu);
+        if (!error)
+          error = std::current_exception();
+        stop = 1;
+      }
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        ++done;
+      }
+      cv.notify_all();
+    }
+  };
+  threads = unsigned(std::max<size_t>(1, std::min<size_t>(threads, k)));
+  std::vector<std::thread> pool;
+  pool.reserve(threads);
+  std::exception_ptr cancelled;
+  try {
+    for (unsigned t = 0; t < threads; ++t)
+      pool.emplace_back(worker);
+    std::unique_lock<std::mutex> lock(mu);
+    while (done.load() < k && !stop.load()) {
+      cv.wait_for(lock, std::chrono::milliseconds(50));
+      lock.unlock();
+      progress.report(double(done.load()) / double(k));
+      lock.lock();
+    }
+  } catch (...) {
+    cancelled = std::current_exception();
+    stop = 1;
+  }
+  for (std::thread &t : pool)
+    t.join();
+  if (cancelled)
+    std::rethrow_exception(cancelled);
+  if (error)
+    std::rethrow_exception(error);
+}
+
+// Phase 1: a tile's own points, triangulated (vertices carry input
+// indices), duplicates resolved as the single triangulation resolves them
+// (each vertex keeps the smallest index of its point).
+void triangulate_own(const double *xyz, Tile &t, Progress &progress) {
+  const size_t n = t.own.size();
+  std::vector<double> local(3 * n);
+  for (size_t i = 0; i < n; ++i)
+    std::memcpy(&local[3 * i], xyz + 3 * size_t(t.own[i]), 3 * sizeof(double));
+  std::vector<uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  hilbert_sort(local.data(), order);
+  order = brio_order(order);
+  Ch hint;
+  for (size_t k = 0; k < n; ++k) {
+    progress.tick(k, n);
+    const double *p = &local[3 * size_t(order[k])];
+    Vh v = t.dt.insert(Point(p[0], p[1], p[2]), hint);
+    // A repeated point comes back as the vertex it repeats (flagged when
+    // it was made), which keeps the smaller index.
+    if (!(v->info().flags & kSeen)) {
+      v->info().idx = t.own[order[k]];
+      v->info().flags = kSeen;
+    } else {
+      const uint32_t j = v->info().idx, i = t.own[order[k]];
+      v->info().idx = std::min(i, j);
+      t.dups.emplace_back(std::max(i, j), std::min(i, j));
+    }
+    hint = v->cell();
+  }
+  for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
+       ++v)
+    v->info().flags = 0;
+  // Of three or more copies, one may have been paired with another that is
+  // not the first: each names the vertex's index, the smallest.
+  if (!t.dups.empty()) {
+    for (auto &d : t.dups) {
+      Point p(xyz[3 * size_t(d.first)], xyz[3 * size_t(d.first) + 1],
+              xyz[3 * size_t(d.first) + 2]);
+      DtSeq::Locate_type lt;
+      int li, lj;
+      Ch c = t.dt.locate(p, lt, li, lj);
+      d.second = c->vertex(li)->info().idx;
+    }
+  }
+}
+
+// A ball that surely holds the circumscribed ball of cell c: its centre
+// and squared radius.
+void enclosing_ball(Ch c, double centre[3], double &r2) {
+  V3 p[4];
+  for (int j = 0; j < 4; ++j)
+    p[j] = v3(c->vertex(j)->point());
+  V3 u = p[1] - p[0], v = p[2] - p[0], w = p[3] - p[0];
+  V3 vw = cross(v, w);
+  const double det = dot(u, vw);
+  const double scale = std::sqrt(norm2(u) * norm2(v) * norm2(w));
+  double longest = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < i; ++j)
+      longest = std::max(longest, norm2(p[i] - p[j]));
+  longest = std::sqrt(longest);
+  if (std::fabs(det) > 1e-6 * scale) {
+    // Well conditioned: the centre in double precision is off by far less
+    // than a millionth of the cell's size.
+    V3 num = norm2(u) * vw + norm2(v) * cross(w, u) + norm2(w) * cross(u, v);
+    V3 cc = p[0] + (0.5 / det) * num;
+    if (finite(cc)) {
+      double r = 0;
+      for (int j = 0; j < 4; ++j)
+        r = std::max(r, std::sqrt(norm2(cc - p[j])));
+      r += 1e-6 * (r + longest);
+      centre[0] = cc.x, centre[1] = cc.y, centre[2] = cc.z;
+      r2 = r * r;
+      return;
+    }
+  }
+  // Nearly flat: the exact centre, rounded outward to a box; the ball
+  // about the box's middle that holds every ball centred in the box.
+  Exact::Point_3 e[4];
+  for (int j = 0; j < 4; ++j)
+    e[j] = Exact::Point_3(p[j].x, p[j].y, p[j].z);
+  const Exact::Point_3 ec = CGAL::circumcenter(e[0], e[1], e[2], e[3]);
+  double lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    const std::pair<double, double> iv = CGAL::to_interval(ec[a]);
+    lo[a] = iv.first, hi[a] = iv.second;
+  }
+  double far2 = 0, half2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    centre[a] = 0.5 * (lo[a] + hi[a]);
+    half2 += 0.25 * (hi[a] - lo[a]) * (hi[a] - lo[a]);
+  }
+  for (int j = 0; j < 4; ++j) {
+    const double q[3] = {p[j].x, p[j].y, p[j].z};
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double d =
+          std::max(std::fabs(q[a] - lo[a]), std::fabs(q[a] - hi[a]));
+      d2 += d * d;
+    }
+    far2 = std::max(far2, d2);
+  }
+  const double r = (std::sqrt(far2) + std::sqrt(half2)) * (1 + 1e-9);
+  r2 = std::isfinite(r) ? r * r : HUGE_VAL;
+}
+
+// Whether the ball lies inside the box, away from its sides.
+inline bool ball_in(const Box &box, const double c[3], double r2) {
+  const double r = std::sqrt(r2);
+  for (int a = 0; a < 3; ++a)
+    if (!(c[a] - r > box.lo[a] && c[a] + r < box.hi[a]))
+      return false;
+  return true;
+}
+
+struct Shared {
+  const double *pts;     // distinct points by vertex number
+  const uint16_t *owner; // by vertex number
+  const PointTree *tree;
+};
+
+// Inserts the vertices `add` (vertex numbers, sorted) into tile t.
+void insert_foreign(const Shared &s, Tile &t, const std::vector<uint32_t> &add,
+                    Progress &progress) {
+  Ch hint;
+  for (size_t k = 0; k < add.size(); ++k) {
+    progress.tick(k, add.size());
+    const uint32_t v = add[k];
+    const double *p = s.pts + 3 * size_t(v);
+    Vh h = t.dt.insert(Point(p[0], p[1], p[2]), hint);
+    h->info() = VertexData(v);
+    t.member[v] = 1;
+    hint = h->cell();
+  }
+  t.foreign += add.size();
+}
+
+// Phase 2: grows tile t until every finite cell with a vertex of its own is
+// certified: its circumscribed ball, closed, holds no point of all that the
+// tile lacks. A ball inside the tile's reach is certified as it is; the
+// others ask the tree, and the exact in-sphere predicate decides. Points
+// found inside (or on the sphere, where the single triangulation's
+// symbolic perturbation decides) are inserted, and the cells checked again.
+void certify(const Shared &s, Tile &t, Progress &progress) {
+  const Ownership own{s.owner, t.id};
+  for (;;) {
+    ++t.rounds;
+    std::vector<uint32_t> add;
+    size_t cells = t.dt.number_of_cells(), k = 0;
+    for (auto c = t.dt.finite_cells_begin(); c != t.dt.finite_cells_end();
+         ++c) {
+      progress.tick(k++, cells);
+      // A cell that was certified stays so: no point of all is in its
+      // ball, so nothing inserted later destroys it. Only cells made since
+      // the last round are checked.
+      uint32_t bits;
+      std::memcpy(&bits, &c->info().cc[0], sizeof bits);
+      if (bits == kChecked)
+        continue;
+      std::memcpy(&c->info().cc[0], &kChecked, sizeof bits);
+      bool mine = false;
+      for (int j = 0; j < 4; ++j)
+        mine = mine || own(c->vertex(j)->info().idx);
+      if (!mine)
+        continue;
+      double centre[3], r2;
+      enclosing_ball(c, centre, r2);
+      if (ball_in(t.reach, centre, r2))
+        continue;
+      ++t.checked;
+      const Point &p0 = c->vertex(0)->point(), &p1 = c->vertex(1)->point(),
+                  &p2 = c->vertex(2)->point(), &p3 = c->vertex(3)->point();
+      // Of the points inside, the one nearest the centre goes in: it
+      // splits the cell, and the cells it makes are checked in the next
+      // round. (Taking every point inside a wrong ball, which may be far
+      // larger than any cell of all, took in most of the other tiles.)
+      uint32_t best = UINT32_MAX;
+      double best_d2 = HUGE_VAL;
+      s.tree->in_ball(centre, r2, t.reach.lo, t.reach.hi, [&](uint32_t v) {
+        if (own(v) || t.member[v])
+          return;
+        const double *q = s.pts + 3 * size_t(v);
+        const double d2 =
+            norm2(V3{q[0] - centre[0], q[1] - centre[1], q[2] - centre[2]});
+        if (d2 >= best_d2)
+          return;
+        if (CGAL::side_of_bounded_sphere(p0, p1, p2, p3,
+                                         Point(q[0], q[1], q[2])) !=
+            CGAL::ON_UNBOUNDED_SIDE)
+          best_d2 = d2, best = v;
+      });
+      if (best != UINT32_MAX)
+        add.push_back(best);
+    }
+    // The hull facets with a vertex of the tile's: one of all only if no
+    // point lies beyond its plane (or on it, inside its circle, where the
+    // perturbation decides). The point beyond nearest to the facet goes
+    // in; the finite cells it makes are checked in the next round.
+    std::vector<Ch> hull;
+    t.dt.incident_cells(t.dt.infinite_vertex(), std::back_inserter(hull));
+    const double ext = s.tree->extent();
+    for (Ch c : hull) {
+      uint32_t bits;
+      std::memcpy(&bits, &c->info().cc[0], sizeof bits);
+      if (bits == kChecked)
+        continue;
+      std::memcpy(&c->info().cc[0], &kChecked, sizeof bits);
+      const int inf = c->index(t.dt.infinite_vertex());
+      Vh fv[3];
+      bool mine = false;
+      for (int j = 0; j < 3; ++j) {
+        fv[j] = c->vertex((inf + 1 + j) % 4);
+        mine = mine || own(fv[j]->info().idx);
+      }
+      if (!mine)
+        continue;
+      ++t.checked;
+      const Point &pa = fv[0]->point(), &pb = fv[1]->point(),
+                  &pc = fv[2]->point();
+      Ch in = c->neighbor(inf);
+      const Point &po = in->vertex(in->index(c))->point();
+      const CGAL::Orientation inner = CGAL::orientation(pa, pb, pc, po);
+      V3 nrm = cross(v3(pb) - v3(pa), v3(pc) - v3(pa));
+      if (dot(nrm, v3(po) - v3(pa)) > 0)
+        nrm = -1.0 * nrm;
+      const double a[3] = {pa.x(), pa.y(), pa.z()},
+                   nv[3] = {nrm.x, nrm.y, nrm.z};
+      const double tol = 1e-9 * std::sqrt(norm2(nrm)) * ext;
+      const V3 mid = (1.0 / 3) * (v3(pa) + v3(pb) + v3(pc));
+      uint32_t best = UINT32_MAX;
+      double best_d2 = HUGE_VAL;
+      s.tree->beyond(a, nv, tol, t.reach.lo, t.reach.hi, [&](uint32_t v) {
+        if (own(v) || t.member[v])
+          return;
+        const double *q = s.pts + 3 * size_t(v);
+        const Point pq(q[0], q[1], q[2]);
+        const CGAL::Orientation o = CGAL::orientation(pa, pb, pc, pq);
+        if (o == inner || (o == CGAL::COPLANAR &&
+                           CGAL::coplanar_side_of_bounded_circle(
+                               pa, pb, pc, pq) == CGAL::ON_UNBOUNDED_SIDE))
+          return;
+        const double d2 = norm2(v3(pq) - mid);
+        if (d2 < best_d2)
+          best_d2 = d2, best = v;
+      });
+      if (best != UINT32_MAX)
+        add.push_back(best);
+    }
+    if (add.empty())
+      return;
+    std::sort(add.begin(), add.end());
+    add.erase(std::unique(add.begin(), add.end()), add.end());
+    insert_foreign(s, t, add, progress);
+  }
+}
+
+} // namespace
+
+// See internal.hpp.
+bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
+                  double margin, const sc_params_t &params, Progress &progress,
+                  Filtered &out, sc_diag_t &diag,
+                  double seconds[SC_STAGE_COUNT]) {
+  Stopwatch sw;
+  progress.stage(SC_STAGE_DELAUNAY);
+  std::vector<Tile> ts;
+  {
+    std::vector<uint32_t> idx(n);
+    std::iota(idx.begin(), idx.end(), 0u);
+    Box all;
+    for (int a = 0; a < 3; ++a)
+      all.lo[a] = -HUGE_VAL, all.hi[a] = HUGE_VAL;
+    ts.reserve(tiles);
+    split(xyz, idx, 0, n, tiles, all, ts);
+  }
+  if (ts.size() < 2)
+    return false;
+  const size_t k = ts.size();
+  unsigned nthreads = threads > 0
+                          ? unsigned(threads)
+                          : std::max(1u, std::thread::hardware_concurrency());
+  for (size_t i = 0; i < k; ++i) {
+    ts[i].id = uint16_t(i);
+    for (int a = 0; a < 3; ++a)
+      ts[i].reach.lo[a] = ts[i].region.lo[a] - margin,
+      ts[i].reach.hi[a] = ts[i].region.hi[a] + margin;
+  }
+
+  // Phase 1: each tile's own points.
+  run_tiles(k, nthreads, progress,
+            [&](size_t i, Progress &p) { triangulate_own(xyz, ts[i], p); });
+
+  // The vertex numbering of the single triangulation (its Hilbert order of
+  // all the points, the first of equal points standing for them).
+  std::vector<uint8_t> is_vertex(n, 0);
+  for (Tile &t : ts) {
+    for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
+         ++v)
+      is_vertex[v->info().idx] = 1;
+    out.dups.insert(out.dups.end(), t.dups.begin(), t.dups.end());
+    t.dups = {};
+  }
+  diag.duplicates_merged = out.dups.size();
+  {
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    hilbert_sort(xyz, order);
+    out.to_input.clear();
+    for (uint32_t i : order)
+      if (is_vertex[i])
+        out.to_input.push_back(i);
+  }
+  is_vertex = {};
+  const size_t m = out.to_input.size();
+  diag.delaunay_vertices = m;
+  std::vector<uint32_t> rank(n, UINT32_MAX);
+  std::vector<double> pts(3 * m);
+  std::vector<uint16_t> owner(m);
+  {
+    std::vector<uint16_t> tile_of(n);
+    for (Tile &t : ts)
+      for (uint32_t i : t.own)
+        tile_of[i] = t.id;
+    for (size_t v = 0; v < m; ++v) {
+      const uint32_t i = out.to_input[v];
+      rank[i] = uint32_t(v);
+      owner[v] = tile_of[i];
+      std::memcpy(&pts[3 * v], xyz + 3 * size_t(i), 3 * sizeof(double));
+    }
+  }
+
+  const PointTree tree(pts.data(), m);
+  const Shared shared{pts.data(), owner.data(), &tree};
+
+  // Phase 2: each tile numbered as the single triangulation, grown by the
+  // hull and its margin, and certified.
+  out.poles.assign(3 * m, 0.0);
+  std::atomic<int> flat{0};
+  run_tiles(k, nthreads, progress, [&](size_t i, Progress &p) {
+    Tile &t = ts[i];
+    for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
+         ++v)
+      v->info() = VertexData(rank[v->info().idx]);
+    t.member.assign(m, 0);
+    std::vector<uint32_t> add;
+    for (size_t v = 0; v < m; ++v)
+      if (owner[v] != t.id && in_box(t.reach, &pts[3 * v]))
+        add.push_back(uint32_t(v));
+    insert_foreign(shared, t, add, p);
+    if (t.dt.dimension() < 3) {
+      flat = 1;
+      return;
+    }
+    certify(shared, t, p);
+  });
+  if (flat.load())
+    return false;
+  seconds[SC_STAGE_DELAUNAY] += sw.lap();
+
+  // Phase 3: poles, each tile's own into the shared array.
+  progress.stage(SC_STAGE_POLES);
+  run_tiles(k, nthreads, progress, [&](size_t i, Progress &p) {
+    Tile &t = ts[i];
+    const Ownership own{owner.data(), t.id};
+    compute_poles(t.dt, t.infinite, p, t.diag, &own);
+    for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
+         ++v)
+      if (own(v->info().idx))
+        std::memcpy(&out.poles[3 * size_t(v->info().idx)], v->info().pole,
+                    sizeof v->info().pole);
+  });
+  seconds[SC_STAGE_POLES] += sw.lap();
+
+  // Phase 4: the candidates, each tile testing the facets it owns with the
+  // poles of all.
+  progress.stage(SC_STAGE_CANDIDATES);
+  run_tiles(k, nthreads, progress, [&](size_t i, Progress &p) {
+    Tile &t = ts[i];
+    const Ownership own{owner.data(), t.id};
+    for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
+         ++v)
+      if (!own(v->info().idx))
+        std::memcpy(v->info().pole, &out.poles[3 * size_t(v->info().idx)],
+                    sizeof v->info().pole);
+    select_candidates(t.dt, t.infinite, params, p, t.tris, t.diag, &own);
+    t.dt.clear();
+    t.member = {};
+  });
+  size_t total = 0;
+  for (const Tile &t : ts)
+    total += t.tris.size();
+  out.tris.reserve(total);
+  for (Tile &t : ts) {
+    out.tris.insert(out.tris.end(), t.tris.begin(), t.tris.end());
+    t.tris = {};
+    diag.delaunay_cells += t.diag.delaunay_cells;
+    diag.delaunay_facets += t.diag.delaunay_facets;
+    diag.hull_facets += t.diag.hull_facets;
+    diag.hull_vertices += t.diag.hull_vertices;
+    diag.degenerate_cells += t.diag.degenerate_cells;
+    diag.tile_points_foreign += t.foreign;
+  }
+  diag.tiles = k;
+  diag.candidates = out.tris.size() / 3;
+  canonical_order(out.tris, false);
+  seconds[SC_STAGE_CANDIDATES] += sw.lap();
+  return true;
+}
+
+} // namespace dt
+} // namespace sc

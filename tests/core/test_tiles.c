@@ -1,0 +1,176 @@
+/*
+ * Tiles (docs/algorithm.md section 17): the same points split into 2 to 16
+ * tiles, run on one thread or two, give exactly the triangles, normals and
+ * counts of one triangulation, in the cocone and shortcrust modes, on a
+ * synthetic sample, a real scan, a grid (cospherical everywhere, flat hull
+ * faces) and a very uneven density; a cancel during the tiles stops them
+ * all; the modes that run one triangulation say so (tiles 0).
+ *
+ *   test_core_tiles [SCAN.ply ...]
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sct_assert.h"
+#include "shortcrust.h"
+#include "shortcrust_files.h"
+#include "synth.h"
+
+static sc_mesh_t *run(const char *what, const double *xyz, size_t n,
+                      sc_mode_t mode, int tiles, int threads) {
+  sc_params_t p;
+  sc_params_init(&p);
+  p.mode = mode;
+  p.tiles = tiles;
+  p.threads = threads;
+  sc_mesh_t *mesh = NULL;
+  char msg[256] = "";
+  int rc = sc_reconstruct(xyz, n, &p, &mesh, msg, sizeof msg);
+  if (rc != 0) {
+    EXPECT_FAIL("%s, %s, %d tiles: %s: %s", what, sc_mode_name(mode), tiles,
+                sc_err_name(rc), msg);
+    return NULL;
+  }
+  return mesh;
+}
+
+/* The tiled mesh must be the single triangulation's, array for array. */
+static void same(const char *what, const sc_mesh_t *a, const sc_mesh_t *b,
+                 int tiles, int threads) {
+  char tag[160];
+  snprintf(tag, sizeof tag, "%s, %d tiles on %d threads", what, tiles, threads);
+  EXPECT_EQ(b->diag.tiles > 1, 1);
+  EXPECT_EQ(a->diag.tiles, 0);
+  if (a->triangle_count != b->triangle_count) {
+    EXPECT_FAIL("%s: %zu triangles, one triangulation %zu", tag,
+                b->triangle_count, a->triangle_count);
+    return;
+  }
+  if (memcmp(a->triangles, b->triangles,
+             3 * a->triangle_count * sizeof *a->triangles) != 0)
+    EXPECT_FAIL("%s: other triangles", tag);
+  if (memcmp(a->normals, b->normals, 3 * a->point_count * sizeof(double)))
+    EXPECT_FAIL("%s: other normals", tag);
+  /* What the triangulation counted, counted once over the tiles. */
+  EXPECT_EQ(a->diag.duplicates_merged, b->diag.duplicates_merged);
+  EXPECT_EQ(a->diag.delaunay_vertices, b->diag.delaunay_vertices);
+  EXPECT_EQ(a->diag.delaunay_cells, b->diag.delaunay_cells);
+  EXPECT_EQ(a->diag.delaunay_facets, b->diag.delaunay_facets);
+  EXPECT_EQ(a->diag.hull_facets, b->diag.hull_facets);
+  EXPECT_EQ(a->diag.hull_vertices, b->diag.hull_vertices);
+  EXPECT_EQ(a->diag.candidates, b->diag.candidates);
+  EXPECT_EQ(a->diag.genus, b->diag.genus);
+  printf("ok: %s: %zu triangles, %llu tiles, %llu points triangulated twice "
+         "(%.0f%%)\n",
+         tag, b->triangle_count, (unsigned long long)b->diag.tiles,
+         (unsigned long long)b->diag.tile_points_foreign,
+         100.0 * (double)b->diag.tile_points_foreign /
+             (double)b->diag.delaunay_vertices);
+}
+
+static void check(const char *what, const double *xyz, size_t n) {
+  const sc_mode_t modes[] = {SC_MODE_COCONE, SC_MODE_SHORTCRUST};
+  const int tiles[][2] = {{2, 1}, {3, 2}, {5, 1}, {16, 2}};
+  for (size_t m = 0; m < 2; ++m) {
+    sc_mesh_t *one = run(what, xyz, n, modes[m], 1, 1);
+    if (!one)
+      continue;
+    EXPECT_GT(one->triangle_count, 0);
+    for (size_t k = 0; k < sizeof tiles / sizeof tiles[0]; ++k) {
+      sc_mesh_t *t = run(what, xyz, n, modes[m], tiles[k][0], tiles[k][1]);
+      if (t)
+        same(what, one, t, tiles[k][0], tiles[k][1]);
+      sc_mesh_free(t);
+    }
+    sc_mesh_free(one);
+  }
+}
+
+static int cancel_in_delaunay(void *user, sc_stage_t stage, double fraction) {
+  (void)fraction;
+  int *calls = user;
+  if (stage == SC_STAGE_DELAUNAY && ++*calls > 3)
+    return 1;
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  /* A torus, well spaced, with a few exact duplicates. */
+  const size_t n = 12000, dups = 50;
+  double *xyz = malloc(3 * (n + dups) * sizeof *xyz);
+  EXPECT_NOT_NULL(xyz);
+  EXPECT_EQ(scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, n, 7, xyz),
+            0);
+  for (size_t i = 0; i < dups; ++i)
+    memcpy(&xyz[3 * (n + i)], &xyz[3 * (i * 97 % n)], 3 * sizeof *xyz);
+  check("torus", xyz, n + dups);
+
+  /* Very uneven density: a genus-2 sample, one end 40 times as dense. */
+  EXPECT_EQ(
+      scs_sample_surface(SCS_SURF_GENUS2, SCS_DENSITY_UNIFORM, n, 11, xyz), 0);
+  size_t kept = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (xyz[3 * i] < 0.5 || i % 40 == 0)
+      memmove(&xyz[3 * kept++], &xyz[3 * i], 3 * sizeof *xyz);
+  check("uneven genus-2", xyz, kept);
+
+  /* A grid: the surface of a box of 61 x 41 x 21 points on every face. */
+  kept = 0;
+  for (int i = 0; i <= 60; ++i)
+    for (int j = 0; j <= 40; ++j)
+      for (int k = 0; k <= 20; ++k)
+        if (i == 0 || i == 60 || j == 0 || j == 40 || k == 0 || k == 20) {
+          xyz[3 * kept] = i * 0.125;
+          xyz[3 * kept + 1] = j * 0.125;
+          xyz[3 * kept + 2] = k * 0.125;
+          ++kept;
+        }
+  check("grid box", xyz, kept);
+
+  /* Real scans, as given. */
+  for (int a = 1; a < argc; ++a) {
+    scf_points_t pts;
+    char msg[256];
+    if (scf_points_read(argv[a], &pts, msg, sizeof msg) != 0) {
+      EXPECT_FAIL("%s: %s", argv[a], msg);
+      continue;
+    }
+    check(argv[a], pts.xyz, pts.count);
+    scf_points_free(&pts);
+  }
+
+  /* Cancel while the tiles triangulate, on two threads. */
+  {
+    EXPECT_EQ(
+        scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, n, 7, xyz), 0);
+    sc_params_t p;
+    sc_params_init(&p);
+    p.tiles = 4;
+    p.threads = 2;
+    int calls = 0;
+    p.progress = cancel_in_delaunay;
+    p.progress_user = &calls;
+    sc_mesh_t *mesh = NULL;
+    char msg[256] = "";
+    EXPECT_EQ(sc_reconstruct(xyz, n, &p, &mesh, msg, sizeof msg),
+              SC_ECANCELLED);
+    EXPECT_NULL(mesh);
+    printf("ok: cancel during the tiles: %s\n", msg);
+  }
+
+  /* The boundary modes run one triangulation whatever the tiles. */
+  {
+    sc_mesh_t *b = run("torus", xyz, n, SC_MODE_BOUNDARY, 4, 1);
+    if (b) {
+      EXPECT_EQ(b->diag.tiles, 0);
+      sc_mesh_free(b);
+    }
+  }
+  free(xyz);
+  return sct_finish("core_tiles");
+}
