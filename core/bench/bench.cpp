@@ -42,6 +42,8 @@ struct Result {
   int closed, manifold;
   int64_t genus;
   int mesh; // the fields above describe an output mesh
+  uint64_t tiles, foreign, vertices; // tiled runs: the overhead
+  uint64_t hash; // of the triangles, to tell a different mesh
 };
 
 double now() {
@@ -149,6 +151,7 @@ Result run_cgal_delaunay(const double *xyz, size_t n) {
 struct Job {
   int mode = SC_MODE_COCONE;
   int denoise = 0;
+  int tiles = 1;
 };
 
 Result run_shortcrust(const double *xyz, size_t n, int threads,
@@ -157,6 +160,7 @@ Result run_shortcrust(const double *xyz, size_t n, int threads,
     sc_params_t p;
     sc_params_init(&p);
     p.threads = threads;
+    p.tiles = job.tiles;
     p.mode = sc_mode_t(job.mode);
     p.denoise = job.denoise;
     sc_mesh_t *m = nullptr;
@@ -168,6 +172,12 @@ Result run_shortcrust(const double *xyz, size_t n, int threads,
     for (int s = 0; s < SC_STAGE_COUNT; ++s)
       r.stage[s] = m->diag.seconds[s];
     check_mesh(n, xyz, m->triangles, m->triangle_count, r);
+    r.hash = 1469598103934665603ull;
+    for (size_t i = 0; i < 3 * m->triangle_count; ++i)
+      r.hash = (r.hash ^ m->triangles[i]) * 1099511628211ull;
+    r.tiles = m->diag.tiles;
+    r.foreign = m->diag.tile_points_foreign;
+    r.vertices = m->diag.delaunay_vertices;
     r.ok = 1;
     sc_mesh_free(m);
   });
@@ -198,8 +208,8 @@ void usage(FILE *f) {
       "[--density NAME]\n"
       "                        [--noise SIGMA] [--input FILE] [--mode MODE] "
       "[--denoise]\n"
-      "                        [--threads N] [--no-peer] [--peer-max N] "
-      "[--seed S]\n\n"
+      "                        [--threads N] [--tiles N] [--no-peer] "
+      "[--peer-max N] [--seed S]\n\n"
       "Times the reconstruction stage by stage on generated samples and "
       "prints, per size,\n"
       "its time and peak memory against CGAL's Delaunay construction of "
@@ -215,6 +225,11 @@ void usage(FILE *f) {
       "  --density    uniform-random, uniform, adaptive (default "
       "uniform-random)\n"
       "  --threads    threads for the parallel run (default: one per core)\n"
+      "  --tiles      also run with N tiles (docs/algorithm.md section 17) on "
+      "1 thread\n"
+      "               and on --threads, and compare their meshes with the "
+      "single\n"
+      "               triangulation's\n"
       "  --no-peer    skip the advancing front\n"
       "  --peer-max   run the advancing front only up to this many points\n"
       "               (default 1000000)\n"
@@ -253,6 +268,7 @@ int main(int argc, char **argv) {
   std::vector<size_t> sizes{100000, 1000000};
   int surface = SCS_SURF_TORUS, density = SCS_DENSITY_UNIFORM_RANDOM;
   int threads = int(std::thread::hardware_concurrency());
+  int tiles = 1;
   bool peer = true;
   size_t peer_max = 1000000;
   uint64_t seed = 1;
@@ -290,6 +306,8 @@ int main(int argc, char **argv) {
       density = scs_density_from_name(value());
     } else if (a == "--threads") {
       threads = std::atoi(value());
+    } else if (a == "--tiles") {
+      tiles = std::atoi(value());
     } else if (a == "--no-peer") {
       peer = false;
     } else if (a == "--peer-max") {
@@ -319,14 +337,15 @@ int main(int argc, char **argv) {
     }
   }
   if (surface < 0 || density < 0 || threads < 1 || job.mode < 0 ||
-      !(noise >= 0)) {
+      !(noise >= 0) || tiles < 1) {
     std::fprintf(stderr, "shortcrust-bench: bad --surface, --density, "
-                         "--threads, --mode or --noise\n");
+                         "--threads, --tiles, --mode or --noise\n");
     return 2;
   }
   if (input)
     sizes.assign(1, 0);
 
+  bool failed = false;
   for (size_t n : sizes) {
     std::vector<double> xyz;
     double t0 = now();
@@ -381,6 +400,32 @@ int main(int argc, char **argv) {
                     par.stage[SC_STAGE_DELAUNAY] /
                         one.stage[SC_STAGE_DELAUNAY]);
     }
+    // Tiles: on one thread (the overhead) and on all (the gain), against
+    // the single triangulation on one thread and CGAL's construction.
+    for (int t = 1; tiles > 1 && one.ok && t <= threads;
+         t = t == 1 ? threads : t + 1) {
+      Job tj = job;
+      tj.tiles = tiles;
+      Result tr = run_shortcrust(xyz.data(), n, t, tj);
+      char name[64];
+      std::snprintf(name, sizeof name, "%d tiles, %d thread%s", tiles, t,
+                    t == 1 ? "" : "s");
+      print_row(name, tr, n);
+      if (!tr.ok)
+        continue;
+      const bool same = tr.triangles == one.triangles && tr.hash == one.hash;
+      std::printf("    %llu tiles, %llu points triangulated twice (%.1f%%), "
+                  "time / 1 thread untiled %.2f, / cgal delaunay %.2f, "
+                  "peak / cgal delaunay %.2f, %s\n",
+                  (unsigned long long)tr.tiles, (unsigned long long)tr.foreign,
+                  100.0 * double(tr.foreign) / double(tr.vertices),
+                  tr.seconds / one.seconds,
+                  dt.ok ? tr.seconds / dt.seconds : 0.0,
+                  dt.ok ? tr.peak_bytes / dt.peak_bytes : 0.0,
+                  same ? "same mesh" : "A DIFFERENT MESH");
+      if (!same)
+        failed = true;
+    }
     Result af{};
     if (peer && n <= peer_max) {
       af = run_advancing_front(xyz.data(), n);
@@ -405,5 +450,5 @@ int main(int argc, char **argv) {
       std::printf("\n\n");
     }
   }
-  return 0;
+  return failed ? 1 : 0;
 }
