@@ -46,15 +46,23 @@ public:
     std::iota(idx_.begin(), idx_.end(), 0u);
     if (m)
       build(0, m);
+    // The points again in the tree's order, so that a leaf's are together.
+    xyz_.resize(3 * m);
+    for (size_t i = 0; i < m; ++i)
+      std::memcpy(&xyz_[3 * i], pts_ + 3 * size_t(idx_[i]), 3 * sizeof(double));
   }
-  // Calls f(v) for every point v within distance sqrt(r2) of c (and maybe a
-  // few more: f decides), except in parts of the tree whose box lies
-  // inside `skip`.
+  // The nearest to c of the points v within distance sqrt(r2) of c, outside
+  // the box `skip`, that f(v) accepts; UINT32_MAX for none. Nearer parts
+  // of the tree first, and the radius shrinks to each point accepted, so
+  // that a ball holding many points costs little more than an empty one.
   template <class F>
-  void in_ball(const double c[3], double r2, const double skip_lo[3],
-               const double skip_hi[3], F &&f) const {
+  uint32_t nearest_in_ball(const double c[3], double r2,
+                           const double skip_lo[3], const double skip_hi[3],
+                           F &&f) const {
+    uint32_t best = UINT32_MAX;
     if (!nodes_.empty())
-      visit(0, c, r2, skip_lo, skip_hi, f);
+      visit(0, box_d2(nodes_[0], c), c, r2, skip_lo, skip_hi, f, best);
+    return best;
   }
 
   // Calls f(v) for every point v on the outer side of the plane through a
@@ -80,6 +88,12 @@ public:
 private:
   static constexpr size_t kLeaf = 8;
 
+  // Whether p lies in the closed box [lo, hi].
+  static bool in_skip(const double *p, const double lo[3], const double hi[3]) {
+    return p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] &&
+           p[2] >= lo[2] && p[2] <= hi[2];
+  }
+
   template <class F>
   void visit_beyond(int32_t id, const double a[3], const double nrm[3],
                     double tol, const double skip_lo[3],
@@ -95,10 +109,11 @@ private:
       return;
     if (nd.left < 0) {
       for (uint32_t i = nd.begin; i < nd.end; ++i) {
-        const double *p = pts_ + 3 * size_t(idx_[i]);
+        const double *p = &xyz_[3 * size_t(i)];
         if (nrm[0] * (p[0] - a[0]) + nrm[1] * (p[1] - a[1]) +
-                nrm[2] * (p[2] - a[2]) >=
-            -tol)
+                    nrm[2] * (p[2] - a[2]) >=
+                -tol &&
+            !in_skip(p, skip_lo, skip_hi))
           f(idx_[i]);
       }
       return;
@@ -143,36 +158,53 @@ private:
     return id;
   }
 
-  template <class F>
-  void visit(int32_t id, const double c[3], double r2, const double skip_lo[3],
-             const double skip_hi[3], F &f) const {
-    const Node &nd = nodes_[size_t(id)];
+  // The squared distance from c to the box of nd.
+  static double box_d2(const Node &nd, const double c[3]) {
     double d2 = 0;
-    bool inside = true;
     for (int a = 0; a < 3; ++a) {
       const double d = c[a] < nd.lo[a]   ? nd.lo[a] - c[a]
                        : c[a] > nd.hi[a] ? c[a] - nd.hi[a]
                                          : 0.0;
       d2 += d * d;
-      inside = inside && nd.lo[a] >= skip_lo[a] && nd.hi[a] <= skip_hi[a];
     }
-    if (d2 > r2 || inside)
+    return d2;
+  }
+
+  template <class F>
+  void visit(int32_t id, double d2, const double c[3], double &r2,
+             const double skip_lo[3], const double skip_hi[3], F &f,
+             uint32_t &best) const {
+    const Node &nd = nodes_[size_t(id)];
+    if (d2 > r2 || (nd.lo[0] >= skip_lo[0] && nd.hi[0] <= skip_hi[0] &&
+                    nd.lo[1] >= skip_lo[1] && nd.hi[1] <= skip_hi[1] &&
+                    nd.lo[2] >= skip_lo[2] && nd.hi[2] <= skip_hi[2]))
       return;
     if (nd.left < 0) {
       for (uint32_t i = nd.begin; i < nd.end; ++i) {
-        const double *p = pts_ + 3 * size_t(idx_[i]);
+        const double *p = &xyz_[3 * size_t(i)];
         const double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
-        if (dx * dx + dy * dy + dz * dz <= r2)
-          f(idx_[i]);
+        const double e2 = dx * dx + dy * dy + dz * dz;
+        if (e2 <= r2 && !in_skip(p, skip_lo, skip_hi) && f(idx_[i])) {
+          r2 = e2;
+          best = idx_[i];
+        }
       }
       return;
     }
-    visit(nd.left, c, r2, skip_lo, skip_hi, f);
-    visit(nd.right, c, r2, skip_lo, skip_hi, f);
+    const double dl = box_d2(nodes_[size_t(nd.left)], c),
+                 dr = box_d2(nodes_[size_t(nd.right)], c);
+    if (dl <= dr) {
+      visit(nd.left, dl, c, r2, skip_lo, skip_hi, f, best);
+      visit(nd.right, dr, c, r2, skip_lo, skip_hi, f, best);
+    } else {
+      visit(nd.right, dr, c, r2, skip_lo, skip_hi, f, best);
+      visit(nd.left, dl, c, r2, skip_lo, skip_hi, f, best);
+    }
   }
 
   const double *pts_;
   std::vector<uint32_t> idx_;
+  std::vector<double> xyz_; // idx_'s points, in its order
   std::vector<Node> nodes_;
 };
 
@@ -364,32 +396,28 @@ void triangulate_own(const double *xyz, Tile &t, Progress &progress) {
 }
 
 // A ball that surely holds the circumscribed ball of cell c: its centre
-// and squared radius.
-void enclosing_ball(Ch c, double centre[3], double &r2) {
+// and radius.
+void enclosing_ball(Ch c, double centre[3], double &radius) {
   V3 p[4];
   for (int j = 0; j < 4; ++j)
     p[j] = v3(c->vertex(j)->point());
-  V3 u = p[1] - p[0], v = p[2] - p[0], w = p[3] - p[0];
-  V3 vw = cross(v, w);
+  const V3 u = p[1] - p[0], v = p[2] - p[0], w = p[3] - p[0];
+  const V3 vw = cross(v, w);
   const double det = dot(u, vw);
-  const double scale = std::sqrt(norm2(u) * norm2(v) * norm2(w));
-  double longest = 0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < i; ++j)
-      longest = std::max(longest, norm2(p[i] - p[j]));
-  longest = std::sqrt(longest);
-  if (std::fabs(det) > 1e-6 * scale) {
+  const double u2 = norm2(u), v2 = norm2(v), w2 = norm2(w);
+  if (det * det > 1e-12 * u2 * v2 * w2) {
     // Well conditioned: the centre in double precision is off by far less
-    // than a millionth of the cell's size.
-    V3 num = norm2(u) * vw + norm2(v) * cross(w, u) + norm2(w) * cross(u, v);
-    V3 cc = p[0] + (0.5 / det) * num;
+    // than a millionth of the cell's size (every edge is at most twice the
+    // longest from p[0]).
+    const V3 num = u2 * vw + v2 * cross(w, u) + w2 * cross(u, v);
+    const V3 cc = p[0] + (0.5 / det) * num;
     if (finite(cc)) {
-      double r = 0;
+      double r2 = 0;
       for (int j = 0; j < 4; ++j)
-        r = std::max(r, std::sqrt(norm2(cc - p[j])));
-      r += 1e-6 * (r + longest);
+        r2 = std::max(r2, norm2(cc - p[j]));
+      const double r = std::sqrt(r2);
+      radius = r + 1e-6 * (r + 2 * std::sqrt(std::max({u2, v2, w2})));
       centre[0] = cc.x, centre[1] = cc.y, centre[2] = cc.z;
-      r2 = r * r;
       return;
     }
   }
@@ -420,12 +448,11 @@ void enclosing_ball(Ch c, double centre[3], double &r2) {
     far2 = std::max(far2, d2);
   }
   const double r = (std::sqrt(far2) + std::sqrt(half2)) * (1 + 1e-9);
-  r2 = std::isfinite(r) ? r * r : HUGE_VAL;
+  radius = std::isfinite(r) ? r : HUGE_VAL;
 }
 
 // Whether the ball lies inside the box, away from its sides.
-inline bool ball_in(const Box &box, const double c[3], double r2) {
-  const double r = std::sqrt(r2);
+inline bool ball_in(const Box &box, const double c[3], double r) {
   for (int a = 0; a < 3; ++a)
     if (!(c[a] - r > box.lo[a] && c[a] + r < box.hi[a]))
       return false;
@@ -438,9 +465,13 @@ struct Shared {
   const PointTree *tree;
 };
 
-// Inserts the vertices `add` (vertex numbers, sorted) into tile t.
-void insert_foreign(const Shared &s, Tile &t, const std::vector<uint32_t> &add,
-                    Progress &progress) {
+// Inserts the vertices `add` (vertex numbers, sorted) into tile t; returns
+// their handles.
+std::vector<Vh> insert_foreign(const Shared &s, Tile &t,
+                               const std::vector<uint32_t> &add,
+                               Progress &progress) {
+  std::vector<Vh> made;
+  made.reserve(add.size());
   Ch hint;
   for (size_t k = 0; k < add.size(); ++k) {
     progress.tick(k, add.size());
@@ -450,126 +481,146 @@ void insert_foreign(const Shared &s, Tile &t, const std::vector<uint32_t> &add,
     h->info() = VertexData(v);
     t.member[v] = 1;
     hint = h->cell();
+    made.push_back(h);
   }
   t.foreign += add.size();
+  return made;
 }
 
-// Phase 2: grows tile t until every finite cell with a vertex of its own is
-// certified: its circumscribed ball, closed, holds no point of all that the
-// tile lacks. A ball inside the tile's reach is certified as it is; the
-// others ask the tree, and the exact in-sphere predicate decides. Points
-// found inside (or on the sphere, where the single triangulation's
-// symbolic perturbation decides) are inserted, and the cells checked again.
+// Marks cell c checked; returns whether it was already.
+inline bool checked_before(Ch c) {
+  uint32_t bits;
+  std::memcpy(&bits, &c->info().cc[0], sizeof bits);
+  if (bits == kChecked)
+    return true;
+  std::memcpy(&c->info().cc[0], &kChecked, sizeof bits);
+  return false;
+}
+
+// Checks finite cell c of tile t (see certify()); a point that makes it
+// wrong goes into add.
+void check_cell(const Shared &s, Tile &t, const Ownership &own, Ch c,
+                std::vector<uint32_t> &add) {
+  bool mine = false;
+  for (int j = 0; j < 4; ++j)
+    mine = mine || own(c->vertex(j)->info().idx);
+  if (!mine)
+    return;
+  double centre[3], r;
+  enclosing_ball(c, centre, r);
+  if (ball_in(t.reach, centre, r))
+    return;
+  const double r2 = r * r;
+  ++t.checked;
+  const Point &p0 = c->vertex(0)->point(), &p1 = c->vertex(1)->point(),
+              &p2 = c->vertex(2)->point(), &p3 = c->vertex(3)->point();
+  // Of the points inside, the one nearest the centre goes in: it splits
+  // the cell, and the cells it makes are checked in the next round.
+  // (Taking every point inside a wrong ball, which may be far larger than
+  // any cell of all, took in most of the other tiles.)
+  const uint32_t best = s.tree->nearest_in_ball(
+      centre, r2, t.reach.lo, t.reach.hi, [&](uint32_t v) {
+        if (own(v) || t.member[v])
+          return false;
+        const double *q = s.pts + 3 * size_t(v);
+        return CGAL::side_of_bounded_sphere(p0, p1, p2, p3,
+                                            Point(q[0], q[1], q[2])) !=
+               CGAL::ON_UNBOUNDED_SIDE;
+      });
+  if (best != UINT32_MAX)
+    add.push_back(best);
+}
+
+// Checks infinite cell c of tile t: its hull facet is one of all the points
+// only if no point lies beyond its plane (or on it, inside its circle,
+// where the perturbation decides). The point beyond nearest to the facet
+// goes into add.
+void check_hull(const Shared &s, Tile &t, const Ownership &own, Ch c,
+                std::vector<uint32_t> &add) {
+  const int inf = c->index(t.dt.infinite_vertex());
+  Vh fv[3];
+  bool mine = false;
+  for (int j = 0; j < 3; ++j) {
+    fv[j] = c->vertex((inf + 1 + j) % 4);
+    mine = mine || own(fv[j]->info().idx);
+  }
+  if (!mine)
+    return;
+  ++t.checked;
+  const Point &pa = fv[0]->point(), &pb = fv[1]->point(), &pc = fv[2]->point();
+  Ch in = c->neighbor(inf);
+  const Point &po = in->vertex(in->index(c))->point();
+  const CGAL::Orientation inner = CGAL::orientation(pa, pb, pc, po);
+  V3 nrm = cross(v3(pb) - v3(pa), v3(pc) - v3(pa));
+  if (dot(nrm, v3(po) - v3(pa)) > 0)
+    nrm = -1.0 * nrm;
+  const double a[3] = {pa.x(), pa.y(), pa.z()}, nv[3] = {nrm.x, nrm.y, nrm.z};
+  const double tol = 1e-9 * std::sqrt(norm2(nrm)) * s.tree->extent();
+  const V3 mid = (1.0 / 3) * (v3(pa) + v3(pb) + v3(pc));
+  uint32_t best = UINT32_MAX;
+  double best_d2 = HUGE_VAL;
+  s.tree->beyond(a, nv, tol, t.reach.lo, t.reach.hi, [&](uint32_t v) {
+    if (own(v) || t.member[v])
+      return;
+    const double *q = s.pts + 3 * size_t(v);
+    const Point pq(q[0], q[1], q[2]);
+    const CGAL::Orientation o = CGAL::orientation(pa, pb, pc, pq);
+    if (o == inner || (o == CGAL::COPLANAR &&
+                       CGAL::coplanar_side_of_bounded_circle(pa, pb, pc, pq) ==
+                           CGAL::ON_UNBOUNDED_SIDE))
+      return;
+    const double d2 = norm2(v3(pq) - mid);
+    if (d2 < best_d2)
+      best_d2 = d2, best = v;
+  });
+  if (best != UINT32_MAX)
+    add.push_back(best);
+}
+
+// Phase 2: grows tile t until every cell with a vertex of its own is
+// certified: a finite cell's circumscribed ball, closed, holds no point of
+// all that the tile lacks; a hull facet has none beyond it. A ball inside
+// the tile's reach is certified as it is; the others ask the tree, and
+// the exact predicates decide. Points that make a cell wrong go in, and the
+// cells they make, which are all around them, are checked in the next
+// round. A certified cell stays so: no point of all is in its ball, so
+// nothing inserted later destroys it.
 void certify(const Shared &s, Tile &t, Progress &progress) {
   const Ownership own{s.owner, t.id};
-  for (;;) {
-    ++t.rounds;
-    std::vector<uint32_t> add;
-    size_t cells = t.dt.number_of_cells(), k = 0;
-    for (auto c = t.dt.finite_cells_begin(); c != t.dt.finite_cells_end();
-         ++c) {
-      progress.tick(k++, cells);
-      // A cell that was certified stays so: no point of all is in its
-      // ball, so nothing inserted later destroys it. Only cells made since
-      // the last round are checked.
-      uint32_t bits;
-      std::memcpy(&bits, &c->info().cc[0], sizeof bits);
-      if (bits == kChecked)
-        continue;
-      std::memcpy(&c->info().cc[0], &kChecked, sizeof bits);
-      bool mine = false;
-      for (int j = 0; j < 4; ++j)
-        mine = mine || own(c->vertex(j)->info().idx);
-      if (!mine)
-        continue;
-      double centre[3], r2;
-      enclosing_ball(c, centre, r2);
-      if (ball_in(t.reach, centre, r2))
-        continue;
-      ++t.checked;
-      const Point &p0 = c->vertex(0)->point(), &p1 = c->vertex(1)->point(),
-                  &p2 = c->vertex(2)->point(), &p3 = c->vertex(3)->point();
-      // Of the points inside, the one nearest the centre goes in: it
-      // splits the cell, and the cells it makes are checked in the next
-      // round. (Taking every point inside a wrong ball, which may be far
-      // larger than any cell of all, took in most of the other tiles.)
-      uint32_t best = UINT32_MAX;
-      double best_d2 = HUGE_VAL;
-      s.tree->in_ball(centre, r2, t.reach.lo, t.reach.hi, [&](uint32_t v) {
-        if (own(v) || t.member[v])
-          return;
-        const double *q = s.pts + 3 * size_t(v);
-        const double d2 =
-            norm2(V3{q[0] - centre[0], q[1] - centre[1], q[2] - centre[2]});
-        if (d2 >= best_d2)
-          return;
-        if (CGAL::side_of_bounded_sphere(p0, p1, p2, p3,
-                                         Point(q[0], q[1], q[2])) !=
-            CGAL::ON_UNBOUNDED_SIDE)
-          best_d2 = d2, best = v;
-      });
-      if (best != UINT32_MAX)
-        add.push_back(best);
-    }
-    // The hull facets with a vertex of the tile's: one of all only if no
-    // point lies beyond its plane (or on it, inside its circle, where the
-    // perturbation decides). The point beyond nearest to the facet goes
-    // in; the finite cells it makes are checked in the next round.
+  std::vector<uint32_t> add;
+  size_t cells = t.dt.number_of_cells(), k = 0;
+  for_cells(t.dt, false, [&](Ch c) {
+    progress.tick(k++, cells);
+    if (!checked_before(c))
+      check_cell(s, t, own, c, add);
+  });
+  {
     std::vector<Ch> hull;
     t.dt.incident_cells(t.dt.infinite_vertex(), std::back_inserter(hull));
-    const double ext = s.tree->extent();
-    for (Ch c : hull) {
-      uint32_t bits;
-      std::memcpy(&bits, &c->info().cc[0], sizeof bits);
-      if (bits == kChecked)
-        continue;
-      std::memcpy(&c->info().cc[0], &kChecked, sizeof bits);
-      const int inf = c->index(t.dt.infinite_vertex());
-      Vh fv[3];
-      bool mine = false;
-      for (int j = 0; j < 3; ++j) {
-        fv[j] = c->vertex((inf + 1 + j) % 4);
-        mine = mine || own(fv[j]->info().idx);
-      }
-      if (!mine)
-        continue;
-      ++t.checked;
-      const Point &pa = fv[0]->point(), &pb = fv[1]->point(),
-                  &pc = fv[2]->point();
-      Ch in = c->neighbor(inf);
-      const Point &po = in->vertex(in->index(c))->point();
-      const CGAL::Orientation inner = CGAL::orientation(pa, pb, pc, po);
-      V3 nrm = cross(v3(pb) - v3(pa), v3(pc) - v3(pa));
-      if (dot(nrm, v3(po) - v3(pa)) > 0)
-        nrm = -1.0 * nrm;
-      const double a[3] = {pa.x(), pa.y(), pa.z()},
-                   nv[3] = {nrm.x, nrm.y, nrm.z};
-      const double tol = 1e-9 * std::sqrt(norm2(nrm)) * ext;
-      const V3 mid = (1.0 / 3) * (v3(pa) + v3(pb) + v3(pc));
-      uint32_t best = UINT32_MAX;
-      double best_d2 = HUGE_VAL;
-      s.tree->beyond(a, nv, tol, t.reach.lo, t.reach.hi, [&](uint32_t v) {
-        if (own(v) || t.member[v])
-          return;
-        const double *q = s.pts + 3 * size_t(v);
-        const Point pq(q[0], q[1], q[2]);
-        const CGAL::Orientation o = CGAL::orientation(pa, pb, pc, pq);
-        if (o == inner || (o == CGAL::COPLANAR &&
-                           CGAL::coplanar_side_of_bounded_circle(
-                               pa, pb, pc, pq) == CGAL::ON_UNBOUNDED_SIDE))
-          return;
-        const double d2 = norm2(v3(pq) - mid);
-        if (d2 < best_d2)
-          best_d2 = d2, best = v;
-      });
-      if (best != UINT32_MAX)
-        add.push_back(best);
-    }
-    if (add.empty())
-      return;
+    for (Ch c : hull)
+      if (!checked_before(c))
+        check_hull(s, t, own, c, add);
+  }
+  ++t.rounds;
+  std::vector<Ch> around;
+  while (!add.empty()) {
     std::sort(add.begin(), add.end());
     add.erase(std::unique(add.begin(), add.end()), add.end());
-    insert_foreign(s, t, add, progress);
+    const std::vector<Vh> made = insert_foreign(s, t, add, progress);
+    add.clear();
+    ++t.rounds;
+    for (Vh v : made) {
+      around.clear();
+      t.dt.incident_cells(v, std::back_inserter(around));
+      for (Ch c : around) {
+        if (checked_before(c))
+          continue;
+        if (t.dt.is_infinite(c))
+          check_hull(s, t, own, c, add);
+        else
+          check_cell(s, t, own, c, add);
+      }
+    }
   }
 }
 
@@ -665,7 +716,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
     for (size_t v = 0; v < m; ++v)
       if (owner[v] != t.id && in_box(t.reach, &pts[3 * v]))
         add.push_back(uint32_t(v));
-    insert_foreign(shared, t, add, p);
+    (void)insert_foreign(shared, t, add, p);
     if (t.dt.dimension() < 3) {
       flat = 1;
       return;
