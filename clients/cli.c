@@ -253,6 +253,24 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
                "shape (curvature %.2f), give --denoise-scale to smooth",
             d->curvature);
   fprintf(f, ".\n");
+  if (d->tiles)
+    fprintf(f,
+            "Tiles: %llu; %llu points triangulated in a second tile "
+            "(%.1f%%).\n",
+            (unsigned long long)d->tiles,
+            (unsigned long long)d->tile_points_foreign,
+            d->delaunay_vertices ? 100.0 * (double)d->tile_points_foreign /
+                                       (double)d->delaunay_vertices
+                                 : 0.0);
+  else if (r->params.tiles != 1)
+    fprintf(f, "Tiles: none, one triangulation: %s.\n",
+            r->params.mode == SC_MODE_BOUNDARY ||
+                    r->params.mode == SC_MODE_WATERTIGHT ||
+                    r->params.mode == SC_MODE_AUTO
+                ? "this mode does not tile"
+            : r->params.tiles == 0 && r->params.threads == 1
+                ? "one tile per thread, and one thread"
+                : "too few points to split (2000 a tile)");
   fprintf(f, "Time: read %.3f s", r->seconds_read);
   if (r->seconds_transfer > 0)
     fprintf(f, ", transfer %.3f s", r->seconds_transfer);

@@ -7,6 +7,8 @@
  * all; the modes that run one triangulation say so (tiles 0).
  *
  *   test_core_tiles [SCAN.ply ...]
+ *   test_core_tiles --quick      (a small torus on two threads, and the
+ *                                 cancel: for the ThreadSanitizer build)
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -100,14 +102,24 @@ static int cancel_in_delaunay(void *user, sc_stage_t stage, double fraction) {
 }
 
 int main(int argc, char **argv) {
+  const int quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
   /* A torus, well spaced, with a few exact duplicates. */
-  const size_t n = 12000, dups = 50;
+  const size_t n = quick ? 5000 : 12000, dups = 50;
   double *xyz = malloc(3 * (n + dups) * sizeof *xyz);
   EXPECT_NOT_NULL(xyz);
   EXPECT_EQ(scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, n, 7, xyz),
             0);
   for (size_t i = 0; i < dups; ++i)
     memcpy(&xyz[3 * (n + i)], &xyz[3 * (i * 97 % n)], 3 * sizeof *xyz);
+  if (quick) {
+    sc_mesh_t *one = run("torus", xyz, n + dups, SC_MODE_COCONE, 1, 1);
+    sc_mesh_t *t = run("torus", xyz, n + dups, SC_MODE_COCONE, 2, 2);
+    if (one && t)
+      same("torus", one, t, 2, 2);
+    sc_mesh_free(one);
+    sc_mesh_free(t);
+    goto cancel;
+  }
   check("torus", xyz, n + dups);
 
   /* Very uneven density: a genus-2 sample, one end 40 times as dense. */
@@ -145,23 +157,26 @@ int main(int argc, char **argv) {
   }
 
   /* Cancel while the tiles triangulate, on two threads. */
-  {
-    EXPECT_EQ(
-        scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, n, 7, xyz), 0);
-    sc_params_t p;
-    sc_params_init(&p);
-    p.tiles = 4;
-    p.threads = 2;
-    int calls = 0;
-    p.progress = cancel_in_delaunay;
-    p.progress_user = &calls;
-    sc_mesh_t *mesh = NULL;
-    char msg[256] = "";
-    EXPECT_EQ(sc_reconstruct(xyz, n, &p, &mesh, msg, sizeof msg),
-              SC_ECANCELLED);
-    EXPECT_NULL(mesh);
-    printf("ok: cancel during the tiles: %s\n", msg);
+cancel : {
+  EXPECT_EQ(scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, n, 7, xyz),
+            0);
+  sc_params_t p;
+  sc_params_init(&p);
+  p.tiles = 4;
+  p.threads = 2;
+  int calls = 0;
+  p.progress = cancel_in_delaunay;
+  p.progress_user = &calls;
+  sc_mesh_t *mesh = NULL;
+  char msg[256] = "";
+  EXPECT_EQ(sc_reconstruct(xyz, n, &p, &mesh, msg, sizeof msg), SC_ECANCELLED);
+  EXPECT_NULL(mesh);
+  printf("ok: cancel during the tiles: %s\n", msg);
+  if (quick) {
+    free(xyz);
+    return sct_finish("core_tiles");
   }
+}
 
   /* The boundary modes run one triangulation whatever the tiles. */
   {
