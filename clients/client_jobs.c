@@ -394,6 +394,9 @@ int sc_client_cancel(sc_client_t *c, sc_client_job_t *job) {
 void scc_resubmit(sc_client_t *c, sc_client_job_t *j) {
   j->resubmit = 0;
   j->in_use = j->begun = j->client_done = j->server_done = 0;
+  /* A CANCEL that went out for it was ours, to free its id on a daemon
+   * that was shutting down; the user's own cancel ends a waiting job. */
+  j->cancelled = 0;
   j->accepted = 0;
   j->server_code = 0;
   j->message[0] = '\0';

@@ -3,8 +3,9 @@
  * and text that is none), the token from the options, a file or
  * SHORTCRUST_TOKEN, refusals with AUTH, and retries: a job whose daemon is
  * killed under it runs again on the daemon restarted at the same address
- * and comes back right, counting its retries; with retries off, or run
- * out, it ends with the loss.
+ * and comes back right, counting its retries, and so does one whose
+ * daemon shuts down under it; with retries run out, it ends with the
+ * loss.
  *
  *   test_clients_tcp DAEMON
  *
@@ -163,6 +164,7 @@ static void addresses_and_tokens(void) {
  * again there. */
 struct restarter {
   int armed, done;
+  int sig; /* SIGKILL, or SIGTERM for a daemon that shuts down */
 };
 
 static int kill_and_restart(void *user, sc_client_job_t *job, uint32_t stage,
@@ -171,9 +173,10 @@ static int kill_and_restart(void *user, sc_client_job_t *job, uint32_t stage,
   if (!r->armed || r->done || stage >= 6)
     return 0;
   r->done = 1;
-  kill(d.pid, SIGKILL);
+  kill(d.pid, r->sig);
   scdt_daemon_wait(&d, 60000);
-  const char *args[] = {"--listen", port_arg, "--token-file", token_file, NULL};
+  const char *args[] = {
+      "--listen", port_arg, "--token-file", token_file, "--grace", "0", NULL};
   scdt_daemon_spawn(&d, args, 0);
   return 0;
 }
@@ -190,7 +193,7 @@ static void retries(void) {
   EXPECT_EQ(p.retries, 0);
   p.retries = 6;
   p.retry_backoff_ms = 50;
-  struct restarter r = {0, 0};
+  struct restarter r = {0, 0, SIGKILL};
   p.progress = kill_and_restart;
   p.progress_user = &r;
   sc_client_params_t q = p;
@@ -216,6 +219,19 @@ static void retries(void) {
   /* The handle goes on, on the new daemon. */
   run_sphere(c, "after the retry");
   EXPECT_EQ(sc_client_ping(c, 10000, NULL), 0);
+
+  /* A daemon that shuts down (no grace: the job ends with SHUTDOWN, then
+   * the connection) is left the same way. */
+  r = (struct restarter){0, 0, SIGTERM};
+  EXPECT_EQ(sc_client_submit(c, &p, big, n, &j), 0);
+  r.armed = 1;
+  ASSERT_NOT_NULL(j);
+  EXPECT_EQ(sc_client_wait(c, j, SCCT_WAIT_MS), 0);
+  EXPECT(r.done);
+  scct_check_mesh("the big job, after a shutdown", SCS_SURF_TORUS, big, n, j);
+  EXPECT_MSG(sc_client_job_retries(j) >= 1, "retries %u",
+             sc_client_job_retries(j));
+  sc_client_job_free(j);
 
   /* Retries run out: the daemon is killed and not started again. */
   p.retries = 2;
