@@ -47,6 +47,11 @@
 
 #define SCC_READ_SIZE (64 * 1024)
 
+/* memset through a volatile pointer: a wipe of memory that is about to be
+ * freed or to go out of scope is otherwise a dead store the compiler may
+ * drop. */
+static void *(*const volatile wipe)(void *, int, size_t) = memset;
+
 static const struct {
   int code;
   const char *name, *text;
@@ -545,13 +550,13 @@ static int read_token_file(sc_client_t *c, const char *path, char *msg,
             "the token file %s must hold one line of 1 to %d "
             "bytes",
             path, SCP_TOKEN_MAX);
-    memset(buf, 0, sizeof buf);
+    wipe(buf, 0, sizeof buf);
     return SC_CLIENT_EAUTH;
   }
   memcpy(c->token, buf, len);
   c->token_len = len;
   c->has_token = 1;
-  memset(buf, 0, sizeof buf);
+  wipe(buf, 0, sizeof buf);
   return 0;
 }
 
@@ -641,7 +646,7 @@ static int open_connection(sc_client_t *c, char *msg, size_t msg_len) {
              "; give the daemon's token (a token file, or SHORTCRUST_TOKEN)");
   /* Wipe the HELLO that held the token. */
   if (c->out.data)
-    memset(c->out.data, 0, c->out.cap);
+    wipe(c->out.data, 0, c->out.cap);
   c->out.len = 0;
   c->out_at = 0;
   if (c->err) {
@@ -786,6 +791,7 @@ void sc_client_free(sc_client_t *c) {
   scp_buf_free(&c->out);
   free(c->rbuf);
   free(c->stats);
+  wipe(c->token, 0, sizeof c->token);
   free(c);
 }
 

@@ -23,6 +23,11 @@
  * network, and any generator of secrets makes more. */
 #define SCD_TOKEN_MIN 16
 
+/* memset through a volatile pointer: a wipe of memory that is about to be
+ * freed or to go out of scope is otherwise a dead store the compiler may
+ * drop. */
+static void *(*const volatile wipe)(void *, int, size_t) = memset;
+
 int scd_token_load(scd_server_t *srv, const char *path) {
   int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOCTTY);
   if (fd < 0) {
@@ -67,13 +72,18 @@ int scd_token_load(scd_server_t *srv, const char *path) {
     scd_error("the token in %s must have %d to %d bytes (one line; the line "
               "end is not part of it)",
               path, SCD_TOKEN_MIN, SCP_TOKEN_MAX);
-    memset(buf, 0, sizeof buf);
+    wipe(buf, 0, sizeof buf);
     return -1;
   }
   memcpy(srv->token, buf, len);
   srv->token_len = len;
-  memset(buf, 0, sizeof buf);
+  wipe(buf, 0, sizeof buf);
   return 0;
+}
+
+void scd_token_forget(scd_server_t *srv) {
+  wipe(srv->token, 0, sizeof srv->token);
+  srv->token_len = 0;
 }
 
 int scd_auth_hello(scd_conn_t *c, const scp_hello_t *h) {

@@ -229,6 +229,8 @@ void scd_listen_cleanup(scd_server_t *srv);
 /* Reads --token-file into srv->token: -1 (logged) when the file is missing,
  * not a regular file, open to group or others, or holds no usable token. */
 int scd_token_load(scd_server_t *srv, const char *path);
+/* Wipes the token from memory, at exit. */
+void scd_token_forget(scd_server_t *srv);
 /* Whether HELLO may go on: 1 on a Unix socket (the token is ignored) or
  * with the right token on TCP; 0 after a fatal ERROR AUTH. */
 int scd_auth_hello(scd_conn_t *c, const scp_hello_t *h);

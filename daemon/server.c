@@ -348,7 +348,7 @@ out_loop:
 out:
   scd_listen_cleanup(srv);
   uv_loop_close(srv->loop);
-  memset(srv->token, 0, sizeof srv->token);
+  scd_token_forget(srv);
   free(srv);
   return rc;
 }
