@@ -126,10 +126,17 @@ void scd_conn_close_now(scd_conn_t *c, const char *reason) {
     c->srv->conns_open--;
     c->counted = 0;
   }
-  scd_info("conn %llu: closed (%s): %llu bytes in, %llu bytes out, %llu "
-           "jobs, %.1f s",
-           (ull)c->id, c->close_reason, (ull)c->bytes_in, (ull)c->bytes_out,
-           (ull)c->jobs_total, scd_ms_between(c->open_ns, uv_hrtime()) / 1e3);
+  /* A balancer's health check opens a TCP connection every second or so,
+   * and runs no job: those come and go at debug level, so that the log
+   * keeps the clients' connections (a refused token is a warning). */
+  int quiet = c->tcp && c->jobs_total == 0 &&
+              strcmp(c->close_reason, "closed by the client") == 0;
+  scd_log(quiet ? SCD_LOG_DEBUG : SCD_LOG_INFO,
+          "conn %llu: closed (%s): %s%s%llu bytes in, %llu bytes out, %llu "
+          "jobs, %.1f s",
+          (ull)c->id, c->close_reason, c->tcp ? c->peer : "",
+          c->tcp ? " over TCP, " : "", (ull)c->bytes_in, (ull)c->bytes_out,
+          (ull)c->jobs_total, scd_ms_between(c->open_ns, uv_hrtime()) / 1e3);
   uv_close(&c->h.handle, on_closed);
 }
 
@@ -346,8 +353,9 @@ static void on_hello(scd_conn_t *c, const scp_frame_t *f) {
   c->out.max_frame = c->wbuf.max_frame = w.max_frame;
   c->state = SCD_CONN_READY;
   c->deadline_ns = 0;
-  scd_info("conn %llu: ready (version %u, max_frame %u)", (ull)c->id,
-           w.version, w.max_frame);
+  scd_log(c->tcp ? SCD_LOG_DEBUG : SCD_LOG_INFO,
+          "conn %llu: ready (version %u, max_frame %u)", (ull)c->id, w.version,
+          w.max_frame);
 }
 
 static void handle_frame(scd_conn_t *c, const scp_frame_t *f) {
@@ -564,8 +572,8 @@ void scd_conn_accept(scd_server_t *srv, uv_stream_t *listener, int tcp) {
   srv->conns_open++;
   c->deadline_ns = c->open_ns + srv->cfg.handshake_ms * 1000000u;
   if (tcp)
-    scd_info("conn %llu: accepted from %s over TCP (%u open)", (ull)c->id,
-             c->peer, srv->conns_open);
+    scd_debug("conn %llu: accepted from %s over TCP (%u open)", (ull)c->id,
+              c->peer, srv->conns_open);
   else
     scd_info("conn %llu: accepted (%u open)", (ull)c->id, srv->conns_open);
   set_reading(c, 1);
