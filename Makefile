@@ -4,7 +4,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 
-.PHONY: all setup configure build test test-sanitize test-tsan fuzz demo bench clean
+.PHONY: all setup configure build test test-sanitize test-tsan fuzz demo cluster-demo bench clean
 
 all: build
 
@@ -46,6 +46,11 @@ fuzz: setup
 
 demo: build
 	bash scripts/demo.sh $(BUILD)
+
+# Three daemons on loopback TCP behind HAProxy, a verified load run through
+# the front, everything stopped at the end.
+cluster-demo: build
+	bash scripts/cluster-demo.sh $(BUILD) 3
 
 bench: build
 	$(BUILD)/bin/shortcrust-bench

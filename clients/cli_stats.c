@@ -14,13 +14,23 @@
 #include "cli_commands.h"
 #include "shortcrust_client.h"
 
+/* The options that say where the daemon is, in both commands' help. */
+#define CONNECT_HELP                                                           \
+  "      --connect ADDR    the daemon: tcp://HOST:PORT, unix://PATH or a\n"    \
+  "                        socket path (default %s)\n"                         \
+  "      --socket PATH     the same as --connect unix://PATH\n"                \
+  "      --token-file FILE the token of a daemon on TCP (default: the\n"       \
+  "                        variable SHORTCRUST_TOKEN)\n"
+
 /* How long the daemon has to answer. */
 #define SC_CLI_ANSWER_MS 10000
 
-enum { OPT_SOCKET = 256, OPT_JSON };
+enum { OPT_SOCKET = 256, OPT_CONNECT, OPT_TOKEN_FILE, OPT_JSON };
 
 static const struct option long_options[] = {
     {"socket", required_argument, NULL, OPT_SOCKET},
+    {"connect", required_argument, NULL, OPT_CONNECT},
+    {"token-file", required_argument, NULL, OPT_TOKEN_FILE},
     {"json", no_argument, NULL, OPT_JSON},
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
@@ -29,13 +39,18 @@ static const struct option long_options[] = {
 /* Options shared by both commands: 0 to go on, otherwise the exit code + 1
  * (help printed, or a bad command line). */
 static int parse(const char *cmd, int argc, char **argv, int allow_json,
-                 const char **socket_path, int *json, void (*usage)(FILE *f)) {
+                 const char **socket_path, const char **token_file, int *json,
+                 void (*usage)(FILE *f)) {
   opterr = 0;
   int c;
   while ((c = getopt_long(argc, argv, ":h", long_options, NULL)) != -1) {
     switch (c) {
     case OPT_SOCKET:
+    case OPT_CONNECT:
       *socket_path = optarg;
+      break;
+    case OPT_TOKEN_FILE:
+      *token_file = optarg;
       break;
     case OPT_JSON:
       if (!allow_json) {
@@ -64,10 +79,12 @@ static int parse(const char *cmd, int argc, char **argv, int allow_json,
   return 0;
 }
 
-static sc_client_t *connect_or_say(const char *socket_path) {
+static sc_client_t *connect_or_say(const char *socket_path,
+                                   const char *token_file) {
   sc_client_options_t opts;
   sc_client_options_init(&opts);
   opts.socket_path = socket_path;
+  opts.token_file = token_file;
   opts.io_timeout_ms = SC_CLI_ANSWER_MS;
   sc_client_t *c = NULL;
   char msg[1024];
@@ -81,11 +98,11 @@ static sc_client_t *connect_or_say(const char *socket_path) {
 static void stats_usage(FILE *f) {
   char sock[256];
   fprintf(f,
-          "usage: shortcrust stats [--socket PATH] [--json]\n\n"
+          "usage: shortcrust stats [--connect ADDR | --socket PATH]\n"
+          "                        [--token-file FILE] [--json]\n\n"
           "Prints the daemon's counters: connections, jobs, points, bytes,\n"
           "workers, memory. Names ending in _total only grow.\n\n"
-          "options:\n"
-          "      --socket PATH     the daemon's socket (default %s)\n"
+          "options:\n" CONNECT_HELP
           "      --json            one JSON object instead of a table\n"
           "  -h, --help            this text\n\n"
           "Exit status: 0 done, 1 no answer from the daemon, 2 bad command "
@@ -110,12 +127,13 @@ static void print_value(FILE *f, const sc_client_value_t *v) {
 }
 
 int sc_cmd_stats(int argc, char **argv) {
-  const char *socket_path = NULL;
+  const char *socket_path = NULL, *token_file = NULL;
   int json = 0;
-  int rc = parse("stats", argc, argv, 1, &socket_path, &json, stats_usage);
+  int rc = parse("stats", argc, argv, 1, &socket_path, &token_file, &json,
+                 stats_usage);
   if (rc)
     return rc - 1;
-  sc_client_t *c = connect_or_say(socket_path);
+  sc_client_t *c = connect_or_say(socket_path, token_file);
   if (!c)
     return SC_EXIT_FAILURE;
   sc_client_value_t *v = NULL;
@@ -166,23 +184,23 @@ int sc_cmd_stats(int argc, char **argv) {
 static void ping_usage(FILE *f) {
   char sock[256];
   fprintf(f,
-          "usage: shortcrust ping [--socket PATH]\n\n"
+          "usage: shortcrust ping [--connect ADDR | --socket PATH] "
+          "[--token-file FILE]\n\n"
           "Checks that the daemon answers, and prints the round trip.\n\n"
-          "options:\n"
-          "      --socket PATH     the daemon's socket (default %s)\n"
-          "  -h, --help            this text\n\n"
+          "options:\n" CONNECT_HELP "  -h, --help            this text\n\n"
           "Exit status: 0 the daemon answered, 1 it did not (the message "
           "says why),\n2 bad command line.\n",
           sc_client_default_socket(sock, sizeof sock));
 }
 
 int sc_cmd_ping(int argc, char **argv) {
-  const char *socket_path = NULL;
+  const char *socket_path = NULL, *token_file = NULL;
   int json = 0;
-  int rc = parse("ping", argc, argv, 0, &socket_path, &json, ping_usage);
+  int rc = parse("ping", argc, argv, 0, &socket_path, &token_file, &json,
+                 ping_usage);
   if (rc)
     return rc - 1;
-  sc_client_t *c = connect_or_say(socket_path);
+  sc_client_t *c = connect_or_say(socket_path, token_file);
   if (!c)
     return SC_EXIT_FAILURE;
   double rtt = 0;

@@ -18,6 +18,11 @@
 #include "shortcrust_client.h"
 #include "shortcrust_files.h"
 
+/* A job is a pure function of its points and options: the command runs it
+ * again, by default, when its connection is lost. */
+#define SC_CLI_RETRIES 3
+#define SC_CLI_RETRY_BACKOFF_MS 200
+
 static void usage(FILE *f) {
   char sock[256];
   fputs(
@@ -35,8 +40,23 @@ static void usage(FILE *f) {
       "options:\n",
       f);
   sc_cli_job_usage_params(f, 0);
-  fprintf(f, "      --socket PATH     the daemon's socket (default %s)\n",
-          sc_client_default_socket(sock, sizeof sock));
+  fprintf(f,
+          "      --connect ADDR    the daemon: tcp://HOST:PORT, unix://PATH "
+          "or a socket\n"
+          "                        path (default %s)\n"
+          "      --socket PATH     the same as --connect unix://PATH\n"
+          "      --token-file FILE the token of a daemon on TCP (default: "
+          "the variable\n"
+          "                        SHORTCRUST_TOKEN)\n"
+          "      --retries N       submit the job again up to N times when "
+          "the connection\n"
+          "                        is lost or the daemon shuts down "
+          "(default %d)\n"
+          "      --retry-backoff MS  wait MS ms before the first retry, twice "
+          "as long\n"
+          "                        before each next one (default %d)\n",
+          sc_client_default_socket(sock, sizeof sock), SC_CLI_RETRIES,
+          SC_CLI_RETRY_BACKOFF_MS);
   sc_cli_job_usage_output(f);
   fputs(
       "Progress (upload, each stage on the daemon, download) goes to stderr\n"
@@ -48,10 +68,20 @@ static void usage(FILE *f) {
       f);
 }
 
-enum { OPT_SOCKET = SC_CLI_OPT_OWN };
+enum {
+  OPT_SOCKET = SC_CLI_OPT_OWN,
+  OPT_CONNECT,
+  OPT_TOKEN_FILE,
+  OPT_RETRIES,
+  OPT_RETRY_BACKOFF
+};
 
 static const struct option own_options[] = {
     {"socket", required_argument, NULL, OPT_SOCKET},
+    {"connect", required_argument, NULL, OPT_CONNECT},
+    {"token-file", required_argument, NULL, OPT_TOKEN_FILE},
+    {"retries", required_argument, NULL, OPT_RETRIES},
+    {"retry-backoff", required_argument, NULL, OPT_RETRY_BACKOFF},
     {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0},
 };
@@ -146,7 +176,8 @@ int sc_cmd_submit(int argc, char **argv) {
   sc_params_t params;
   /* The daemon's reconstruction runs on one thread. */
   o.params.threads = 1;
-  const char *socket_path = NULL;
+  const char *socket_path = NULL, *token_file = NULL;
+  long retries = SC_CLI_RETRIES, backoff = SC_CLI_RETRY_BACKOFF_MS;
 
   sc_cli_getopt_t g;
   if (sc_cli_job_getopt(&g, 0, own_options, "h") < 0) {
@@ -165,7 +196,19 @@ int sc_cmd_submit(int argc, char **argv) {
       continue;
     switch (c) {
     case OPT_SOCKET:
+    case OPT_CONNECT:
       socket_path = optarg;
+      break;
+    case OPT_TOKEN_FILE:
+      token_file = optarg;
+      break;
+    case OPT_RETRIES:
+      if (sc_cli_parse_int("--retries", optarg, 0, 1000, &retries) < 0)
+        return SC_EXIT_USAGE;
+      break;
+    case OPT_RETRY_BACKOFF:
+      if (sc_cli_parse_int("--retry-backoff", optarg, 0, 60000, &backoff) < 0)
+        return SC_EXIT_USAGE;
       break;
     case 'h':
       usage(stdout);
@@ -192,6 +235,7 @@ int sc_cmd_submit(int argc, char **argv) {
   sc_client_options_t opts;
   sc_client_options_init(&opts);
   opts.socket_path = socket_path;
+  opts.token_file = token_file;
   sc_client_t *client = NULL;
   int rc = sc_client_connect(&opts, &client, msg, sizeof msg);
   if (rc < 0) {
@@ -228,6 +272,8 @@ int sc_cmd_submit(int argc, char **argv) {
   cp.normals = o.normals;
   cp.progress = show_progress;
   cp.progress_user = &progress;
+  cp.retries = (int)retries;
+  cp.retry_backoff_ms = (int)backoff;
   sc_client_job_t *job = NULL;
   rc = sc_client_submit(client, &cp, pts.xyz, pts.count, &job);
   if (rc == 0)

@@ -4,6 +4,11 @@
  * and STATS. Jobs are in client_jobs.c, the frames from the daemon and the
  * results in client_results.c (client_internal.h).
  *
+ * A handle remembers its address and token, so that when its connection
+ * is lost with jobs whose parameters allow retries, it connects anew and
+ * submits them again (scc_recover(), called by the calls that wait for or
+ * start jobs; see sc_client_params_t.retries).
+ *
  * DESIGN. No threads and no locks: a handle belongs to one thread at a
  * time, and nothing here is global. Every blocking call funnels into
  * scc_run_io(), which writes what the handle has queued in c->out, reads what
@@ -26,17 +31,26 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <time.h>
 #include <unistd.h>
 
 #define SCC_READ_SIZE (64 * 1024)
+
+/* memset through a volatile pointer: a wipe of memory that is about to be
+ * freed or to go out of scope is otherwise a dead store the compiler may
+ * drop. */
+static void *(*const volatile wipe)(void *, int, size_t) = memset;
 
 static const struct {
   int code;
@@ -142,6 +156,12 @@ void scc_conn_die(sc_client_t *c, int code, const char *fmt, ...) {
     }
     j->client_done = j->server_done = 1;
     scc_update_in_use(c, j);
+    if (j->resubmit)
+      continue;
+    if (j->status == SC_CLIENT_PENDING && scc_may_retry(j, code)) {
+      j->resubmit = 1;
+      continue;
+    }
     scc_settle(c, j,
                j->local_err   ? j->local_err
                : j->cancelled ? SC_CLIENT_ECANCELLED
@@ -362,10 +382,10 @@ int scc_flush_out(sc_client_t *c) {
 
 static int cond_ready(sc_client_t *c, void *arg) { return c->ready != 0; }
 
-/* Connects c->fd to the daemon's socket at path and makes it
+/* Connects c->fd to the daemon's Unix socket at path and makes it
  * non-blocking: 0, or the error code with its message in msg. */
-static int connect_socket(sc_client_t *c, const char *path, char *msg,
-                          size_t msg_len) {
+static int connect_unix(sc_client_t *c, const char *path, char *msg,
+                        size_t msg_len) {
   struct sockaddr_un sa;
   memset(&sa, 0, sizeof sa);
   sa.sun_family = AF_UNIX;
@@ -406,6 +426,241 @@ static int connect_socket(sc_client_t *c, const char *path, char *msg,
   return 0;
 }
 
+/* One TCP address: a non-blocking connect that waits at most timeout_ms.
+ * The fd, or -errno. */
+static int connect_one(const struct addrinfo *ai, int timeout_ms) {
+  int fd = socket(ai->ai_family, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+  if (fd < 0)
+    return -errno;
+  int rc = connect(fd, ai->ai_addr, ai->ai_addrlen);
+  int e = rc == 0 ? 0 : errno;
+  if (e == EINPROGRESS || e == EINTR) {
+    struct pollfd p = {.fd = fd, .events = POLLOUT};
+    double deadline = scc_deadline_after(timeout_ms);
+    for (;;) {
+      int ms = -1;
+      if (deadline >= 0) {
+        double left = (deadline - scc_now_s()) * 1000.0;
+        ms = left <= 0 ? 0 : (int)left + 1;
+      }
+      rc = poll(&p, 1, ms);
+      if (rc < 0 && errno == EINTR)
+        continue;
+      break;
+    }
+    socklen_t len = sizeof e;
+    if (rc == 0)
+      e = ETIMEDOUT;
+    else if (rc < 0)
+      e = errno;
+    else if (getsockopt(fd, SOL_SOCKET, SO_ERROR, &e, &len) != 0)
+      e = errno;
+  }
+  if (e != 0) {
+    close(fd);
+    return -e;
+  }
+  /* Frames go out whole: Nagle's delay would only hold back the small
+   * ones (JOB_END, PING) behind an acknowledgement. */
+  int one = 1;
+  setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+  return fd;
+}
+
+/* Connects c->fd to the daemon's TCP address, trying each address the
+ * host name gives: 0, or the error code with its message in msg. */
+static int connect_tcp(sc_client_t *c, int timeout_ms, char *msg,
+                       size_t msg_len) {
+  char port[8];
+  snprintf(port, sizeof port, "%u", (unsigned)c->addr.port);
+  struct addrinfo hints, *res = NULL;
+  memset(&hints, 0, sizeof hints);
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_NUMERICSERV;
+  int rc = getaddrinfo(c->addr.host, port, &hints, &res);
+  if (rc != 0 || !res) {
+    set_msg(msg, msg_len, "cannot resolve %s: %s", c->addr.host,
+            gai_strerror(rc));
+    return SC_CLIENT_ECONNECT;
+  }
+  int e = EHOSTUNREACH;
+  for (const struct addrinfo *ai = res; ai; ai = ai->ai_next) {
+    int fd = connect_one(ai, timeout_ms);
+    if (fd >= 0) {
+      c->fd = fd;
+      freeaddrinfo(res);
+      return 0;
+    }
+    e = -fd;
+  }
+  freeaddrinfo(res);
+  if (e == ECONNREFUSED) {
+    set_msg(msg, msg_len,
+            "the daemon is not running: nothing listens on %s (%s)", c->path,
+            strerror(e));
+    return SC_CLIENT_ENODAEMON;
+  }
+  set_msg(msg, msg_len, "cannot connect to the daemon on %s: %s", c->path,
+          strerror(e));
+  return e == ETIMEDOUT ? SC_CLIENT_ETIMEOUT : SC_CLIENT_ECONNECT;
+}
+
+/* The token file: the daemon's rules (one line; open to its owner only),
+ * so that a file the daemon would refuse is not used here either. */
+static int read_token_file(sc_client_t *c, const char *path, char *msg,
+                           size_t msg_len) {
+  int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    set_msg(msg, msg_len, "cannot open the token file %s: %s", path,
+            strerror(errno));
+    return SC_CLIENT_EAUTH;
+  }
+  struct stat st;
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || (st.st_mode & 077)) {
+    set_msg(msg, msg_len,
+            "the token file %s must be a regular file open to its owner "
+            "only (chmod 600 %s)",
+            path, path);
+    close(fd);
+    return SC_CLIENT_EAUTH;
+  }
+  uint8_t buf[SCP_TOKEN_MAX + 3];
+  size_t len = 0;
+  for (;;) {
+    ssize_t n = read(fd, buf + len, sizeof buf - len);
+    if (n < 0 && errno == EINTR)
+      continue;
+    if (n < 0) {
+      set_msg(msg, msg_len, "cannot read the token file %s: %s", path,
+              strerror(errno));
+      close(fd);
+      return SC_CLIENT_EAUTH;
+    }
+    if (n == 0 || (len += (size_t)n) == sizeof buf)
+      break;
+  }
+  close(fd);
+  if (len && buf[len - 1] == '\n')
+    len--;
+  if (len && buf[len - 1] == '\r')
+    len--;
+  if (len == 0 || len > SCP_TOKEN_MAX) {
+    set_msg(msg, msg_len,
+            "the token file %s must hold one line of 1 to %d "
+            "bytes",
+            path, SCP_TOKEN_MAX);
+    wipe(buf, 0, sizeof buf);
+    return SC_CLIENT_EAUTH;
+  }
+  memcpy(c->token, buf, len);
+  c->token_len = len;
+  c->has_token = 1;
+  wipe(buf, 0, sizeof buf);
+  return 0;
+}
+
+/* The token for a TCP daemon: the options' own, their file, or
+ * SHORTCRUST_TOKEN; none is not an error here (the daemon says AUTH). */
+static int load_token(sc_client_t *c, const sc_client_options_t *o, char *msg,
+                      size_t msg_len) {
+  const char *t = o->token;
+  if (!t && o->token_file)
+    return read_token_file(c, o->token_file, msg, msg_len);
+  if (!t)
+    t = getenv("SHORTCRUST_TOKEN");
+  if (!t || !*t)
+    return 0;
+  if (strlen(t) > SCP_TOKEN_MAX) {
+    set_msg(msg, msg_len, "the token is longer than %d bytes", SCP_TOKEN_MAX);
+    return SC_CLIENT_EAUTH;
+  }
+  c->token_len = strlen(t);
+  memcpy(c->token, t, c->token_len);
+  c->has_token = 1;
+  return 0;
+}
+
+/* Opens the connection and does the handshake, on a handle that is new or
+ * whose connection is gone: 0 with the handle ready, or the error code
+ * with its message in msg (the handle then has no connection, c->err set). */
+static int open_connection(sc_client_t *c, char *msg, size_t msg_len) {
+  if (c->fd >= 0) {
+    close(c->fd);
+    c->fd = -1;
+  }
+  scp_decoder_free(c->dec);
+  scp_limits_t lim;
+  scp_limits_init(&lim);
+  lim.role = SCP_ROLE_CLIENT;
+  c->dec = scp_decoder_new(&lim);
+  scp_buf_free(&c->out);
+  scp_buf_init(&c->out, SCP_FRAME_MIN);
+  c->out_at = 0;
+  c->ready = 0;
+  c->err = 0;
+  c->errmsg[0] = '\0';
+  memset(&c->welcome, 0, sizeof c->welcome);
+  c->ping_waiting = c->pong_seen = 0;
+  c->stats_waiting = c->stats_seen = 0;
+  if (!c->dec) {
+    set_msg(msg, msg_len, "out of memory");
+    c->err = SC_CLIENT_ENOMEM;
+    return c->err;
+  }
+  int tcp = c->addr.kind == SCP_ADDR_TCP;
+  int rc = tcp ? connect_tcp(c, c->io_timeout_ms, msg, msg_len)
+               : connect_unix(c, c->addr.path[0] ? c->addr.path : c->path, msg,
+                              msg_len);
+  if (rc != 0) {
+    if (c->fd >= 0) {
+      close(c->fd);
+      c->fd = -1;
+    }
+    c->err = rc;
+    snprintf(c->errmsg, sizeof c->errmsg, "%s", msg ? msg : "");
+    return rc;
+  }
+
+  /* The token goes over TCP only (PROTOCOL.md 5.1). */
+  c->hello = (scp_hello_t){.version_min = SCP_VERSION,
+                           .version_max = SCP_VERSION,
+                           .features = SCP_FEATURE_JOB_OPTIONS,
+                           .max_frame = c->max_frame_opt};
+  if (tcp && c->has_token) {
+    c->hello.features |= SCP_FEATURE_TOKEN;
+    c->hello.token = c->token;
+    c->hello.token_len = (uint32_t)c->token_len;
+  }
+  if (scp_enc_hello(&c->out, &c->hello) < 0)
+    scc_conn_die(c, SC_CLIENT_ENOMEM, "out of memory");
+  c->hello.token = NULL;
+  rc = scc_run_io(c, cond_ready, NULL, scc_deadline_after(c->io_timeout_ms));
+  if (rc == SC_CLIENT_ETIMEOUT && !c->err)
+    scc_conn_die(c, SC_CLIENT_ETIMEOUT,
+                 "no answer from the daemon on %s in %d ms", c->path,
+                 c->io_timeout_ms);
+  if (c->err == SC_CLIENT_EAUTH && !c->has_token)
+    snprintf(c->errmsg + strlen(c->errmsg),
+             sizeof c->errmsg - strlen(c->errmsg),
+             "; give the daemon's token (a token file, or SHORTCRUST_TOKEN)");
+  /* Wipe the HELLO that held the token. */
+  if (c->out.data)
+    wipe(c->out.data, 0, c->out.cap);
+  c->out.len = 0;
+  c->out_at = 0;
+  if (c->err) {
+    set_msg(msg, msg_len, "%s", c->errmsg);
+    return c->err;
+  }
+  c->ready = 1;
+  scp_decoder_set_max_frame(c->dec, c->welcome.max_frame);
+  c->out.max_frame = c->welcome.max_frame;
+  /* Frames that came right behind WELCOME. */
+  drain(c);
+  return 0;
+}
+
 int sc_client_connect(const sc_client_options_t *opts, sc_client_t **out,
                       char *msg, size_t msg_len) {
   if (out)
@@ -427,54 +682,102 @@ int sc_client_connect(const sc_client_options_t *opts, sc_client_t **out,
   }
   c->fd = -1;
   c->io_timeout_ms = o.io_timeout_ms;
+  c->max_frame_opt = o.max_frame ? o.max_frame : 1u << 20;
   c->next_id = 1;
   if (o.socket_path)
     snprintf(c->path, sizeof c->path, "%s", o.socket_path);
   else
     sc_client_default_socket(c->path, sizeof c->path);
-  scp_limits_t lim;
-  scp_limits_init(&lim);
-  lim.role = SCP_ROLE_CLIENT;
-  c->dec = scp_decoder_new(&lim);
-  c->rbuf = malloc(SCC_READ_SIZE);
-  scp_buf_init(&c->out, SCP_FRAME_MIN);
-  if (!c->dec || !c->rbuf) {
-    sc_client_free(c);
-    set_msg(msg, msg_len, "out of memory");
-    return SC_CLIENT_ENOMEM;
+  if (scp_address_parse(c->path, &c->addr) != 0 && !strstr(c->path, "://")) {
+    /* A plain path too long for a socket: connecting says so. */
+    c->addr.kind = SCP_ADDR_UNIX;
+  } else if (c->addr.kind == 0) {
+    set_msg(msg, msg_len,
+            "'%s' is not an address: want a socket path, unix://PATH or "
+            "tcp://HOST:PORT",
+            c->path);
+    free(c);
+    return SC_CLIENT_EINVAL;
   }
-
-  const char *path = o.socket_path ? o.socket_path : c->path;
-  int rc = connect_socket(c, path, msg, msg_len);
+  int rc = c->addr.kind == SCP_ADDR_TCP ? load_token(c, &o, msg, msg_len) : 0;
+  c->rbuf = malloc(SCC_READ_SIZE);
+  if (rc == 0 && !c->rbuf) {
+    set_msg(msg, msg_len, "out of memory");
+    rc = SC_CLIENT_ENOMEM;
+  }
+  if (rc == 0)
+    rc = open_connection(c, msg, msg_len);
   if (rc != 0) {
     sc_client_free(c);
     return rc;
   }
-
-  c->hello = (scp_hello_t){.version_min = SCP_VERSION,
-                           .version_max = SCP_VERSION,
-                           .features = SCP_FEATURE_JOB_OPTIONS,
-                           .max_frame = o.max_frame ? o.max_frame : 1u << 20};
-  if (scp_enc_hello(&c->out, &c->hello) < 0)
-    scc_conn_die(c, SC_CLIENT_ENOMEM, "out of memory");
-  rc = scc_run_io(c, cond_ready, NULL, scc_deadline_after(o.io_timeout_ms));
-  if (rc == SC_CLIENT_ETIMEOUT && !c->err)
-    scc_conn_die(c, SC_CLIENT_ETIMEOUT,
-                 "no answer from the daemon on %s in %d ms", path,
-                 o.io_timeout_ms);
-  if (c->err) {
-    set_msg(msg, msg_len, "%s", c->errmsg);
-    rc = c->err;
-    sc_client_free(c);
-    return rc;
-  }
-  c->ready = 1;
-  scp_decoder_set_max_frame(c->dec, c->welcome.max_frame);
-  c->out.max_frame = c->welcome.max_frame;
-  /* Frames that came right behind WELCOME. */
-  drain(c);
   *out = c;
   return 0;
+}
+
+int scc_waiting(const sc_client_t *c) {
+  for (const sc_client_job_t *j = c->jobs; j; j = j->next)
+    if (j->resubmit)
+      return 1;
+  return 0;
+}
+
+int scc_may_retry(const sc_client_job_t *j, int code) {
+  return (code == SC_CLIENT_ELOST || code == SC_CLIENT_ESHUTDOWN) &&
+         !j->cancelled && !j->local_err && !j->user_freed && j->xyz &&
+         j->retries_used <
+             (unsigned)(j->params.retries > 0 ? j->params.retries : 0);
+}
+
+static void sleep_ms(int ms) {
+  struct timespec ts = {.tv_sec = ms / 1000,
+                        .tv_nsec = (long)(ms % 1000) * 1000000L};
+  while (nanosleep(&ts, &ts) != 0 && errno == EINTR)
+    ;
+}
+
+int scc_recover(sc_client_t *c) {
+  if (c->recovering || c->in_callback)
+    return c->err;
+  c->recovering = 1;
+  while (c->err && scc_waiting(c)) {
+    /* The longest back-off any waiting job asks for at its attempt. */
+    int wait = 0;
+    for (sc_client_job_t *j = c->jobs; j; j = j->next)
+      if (j->resubmit) {
+        long ms =
+            j->params.retry_backoff_ms > 0 ? j->params.retry_backoff_ms : 0;
+        for (unsigned i = 0; i < j->retries_used && ms < 10000; i++)
+          ms *= 2;
+        if (ms > 10000)
+          ms = 10000;
+        if (ms > wait)
+          wait = (int)ms;
+        j->retries_used++;
+      }
+    if (wait)
+      sleep_ms(wait);
+    char msg[SCC_MSG_MAX];
+    int rc = open_connection(c, msg, sizeof msg);
+    if (rc != 0) {
+      /* An attempt that failed counts as a retry: the jobs that have none
+       * left end with its error. */
+      for (sc_client_job_t *j = c->jobs; j; j = j->next)
+        if (j->resubmit && j->retries_used >= (unsigned)j->params.retries) {
+          j->resubmit = 0;
+          snprintf(j->message, sizeof j->message, "%.1200s (after %u retries)",
+                   msg, j->retries_used);
+          scc_settle(c, j, rc);
+        }
+      continue;
+    }
+    for (sc_client_job_t *j = c->jobs; j && !c->err; j = j->next)
+      if (j->resubmit)
+        scc_resubmit(c, j);
+  }
+  c->recovering = 0;
+  scc_reap(c);
+  return c->err;
 }
 
 void sc_client_free(sc_client_t *c) {
@@ -488,6 +791,7 @@ void sc_client_free(sc_client_t *c) {
   scp_buf_free(&c->out);
   free(c->rbuf);
   free(c->stats);
+  wipe(c->token, 0, sizeof c->token);
   free(c);
 }
 
@@ -516,6 +820,8 @@ int scc_usable(sc_client_t *c) {
   if (c->in_callback)
     return scc_fail(c, SC_CLIENT_ESTATE,
                     "a callback may not call the library on its own handle");
+  if (c->err && scc_waiting(c))
+    scc_recover(c);
   if (c->err) {
     snprintf(c->last, sizeof c->last, "%s", c->errmsg);
     return c->err;

@@ -40,7 +40,10 @@ struct sc_client_job {
 
   sc_client_params_t params;
   uint64_t n;
-  double *own_xyz; /* points read from a file */
+  double *own_xyz;   /* points read from a file */
+  const double *xyz; /* the points, kept for a retry */
+  unsigned retries_used;
+  int resubmit; /* its connection is gone; waits to be submitted again */
 
   uint32_t *tri;
   uint64_t ntri, tri_cap;
@@ -59,7 +62,13 @@ struct sc_client_job {
 
 struct sc_client {
   int fd;
-  char path[sizeof(((struct sockaddr_un *)0)->sun_path)];
+  char path[SCP_ADDR_HOST_MAX + 128]; /* the address, as given */
+  scp_address_t addr;
+  uint8_t token[SCP_TOKEN_MAX]; /* sent over TCP only */
+  size_t token_len;
+  int has_token;
+  uint32_t max_frame_opt;
+  int recovering; /* scc_recover() is under way */
   int io_timeout_ms;
   scp_decoder_t *dec;
   scp_buf_t out;
@@ -107,6 +116,15 @@ int scc_run_io(sc_client_t *c, scc_cond_fn cond, void *arg, double deadline);
 double scc_deadline_after(int timeout_ms);
 /* Writes out everything queued. */
 int scc_flush_out(sc_client_t *c);
+/* 1 when some job waits to be submitted again on a new connection. */
+int scc_waiting(const sc_client_t *c);
+/* The connection is gone and jobs wait for a retry: connects anew, with
+ * the back-off of their parameters, and submits them again. 0 once the
+ * connection is up again (c->err 0), else the error (the jobs that ran out
+ * of retries have ended with it). */
+int scc_recover(sc_client_t *c);
+/* Whether a job whose connection ended with code may be run again. */
+int scc_may_retry(const sc_client_job_t *j, int code);
 
 /* client_jobs.c */
 sc_client_job_t *scc_find_in_use(sc_client_t *c, uint32_t id);
@@ -120,6 +138,8 @@ void scc_settle(sc_client_t *c, sc_client_job_t *j, int status);
 void scc_drop_mesh(sc_client_job_t *j);
 /* A CANCEL for the job, unless one went out already or its id is free. */
 void scc_queue_cancel(sc_client_t *c, sc_client_job_t *j);
+/* Submits a job that waits for a retry again, on the new connection. */
+void scc_resubmit(sc_client_t *c, sc_client_job_t *j);
 
 /* client_params.c */
 /* The most job options one job sends: the option rows of the table. */

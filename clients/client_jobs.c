@@ -247,8 +247,12 @@ static int submit(sc_client_t *c, const sc_client_params_t *params,
   if (!j)
     return scc_fail(c, SC_CLIENT_ENOMEM, "out of memory");
   j->own_xyz = own;
+  j->xyz = xyz;
   j->id = free_id(c);
   rc = upload(c, j, xyz);
+  /* Lost during its upload: with retries, the job goes on elsewhere. */
+  if (rc == 0 && c->err && j->resubmit)
+    scc_recover(c);
   if (rc == 0 && c->err)
     rc = scc_fail(c, c->err, "%s", c->errmsg);
   if (rc < 0) {
@@ -310,8 +314,14 @@ int sc_client_wait(sc_client_t *c, sc_client_job_t *job, int timeout_ms) {
     return scc_fail(c, SC_CLIENT_ESTATE,
                     "a callback may not call the library on its own handle");
   int rc = 0;
-  if (job->status == SC_CLIENT_PENDING)
-    rc = scc_run_io(c, cond_job_ended, job, scc_deadline_after(timeout_ms));
+  double deadline = scc_deadline_after(timeout_ms);
+  while (job->status == SC_CLIENT_PENDING) {
+    rc = scc_run_io(c, cond_job_ended, job, deadline);
+    /* The connection is gone and the job waits for a retry. */
+    if (job->status != SC_CLIENT_PENDING || !c->err || !job->resubmit ||
+        scc_recover(c) != 0)
+      break;
+  }
   scc_reap(c);
   if (job->status == SC_CLIENT_PENDING)
     return scc_fail(c, rc < 0 ? rc : SC_CLIENT_ETIMEOUT,
@@ -323,7 +333,7 @@ int sc_client_wait(sc_client_t *c, sc_client_job_t *job, int timeout_ms) {
 }
 
 static int cond_any_ended(sc_client_t *c, void *arg) {
-  return c->ehead != NULL || c->in_use == 0;
+  return c->ehead != NULL || (c->in_use == 0 && !scc_waiting(c));
 }
 
 int sc_client_wait_any(sc_client_t *c, int timeout_ms, sc_client_job_t **job) {
@@ -334,9 +344,16 @@ int sc_client_wait_any(sc_client_t *c, int timeout_ms, sc_client_job_t **job) {
   if (c->in_callback)
     return scc_fail(c, SC_CLIENT_ESTATE,
                     "a callback may not call the library on its own handle");
-  if (!c->ehead && c->in_use == 0)
+  if (!c->ehead && c->in_use == 0 && !scc_waiting(c))
     return scc_fail(c, SC_CLIENT_ESTATE, "no job under way");
-  int rc = scc_run_io(c, cond_any_ended, NULL, scc_deadline_after(timeout_ms));
+  double deadline = scc_deadline_after(timeout_ms);
+  int rc;
+  for (;;) {
+    rc = scc_run_io(c, cond_any_ended, NULL, deadline);
+    /* The connection is gone and jobs wait for a retry. */
+    if (c->ehead || !c->err || !scc_waiting(c) || scc_recover(c) != 0)
+      break;
+  }
   scc_reap(c);
   sc_client_job_t *j = c->ehead;
   if (!j) {
@@ -358,12 +375,55 @@ int sc_client_cancel(sc_client_t *c, sc_client_job_t *job) {
     return scc_fail(c, SC_CLIENT_ESTATE,
                     "a callback may not call the library on its own handle; "
                     "return non-zero from it to cancel");
+  if (job->resubmit) {
+    /* Waiting for a retry: it simply does not run again. */
+    job->resubmit = 0;
+    job->cancelled = 1;
+    snprintf(job->message, sizeof job->message, "cancelled");
+    scc_settle(c, job, SC_CLIENT_ECANCELLED);
+    return 0;
+  }
   if (job->status != SC_CLIENT_PENDING || c->err)
     return 0;
   scc_queue_cancel(c, job);
   scc_flush_out(c);
   scc_reap(c);
   return 0;
+}
+
+void scc_resubmit(sc_client_t *c, sc_client_job_t *j) {
+  j->resubmit = 0;
+  j->in_use = j->begun = j->client_done = j->server_done = 0;
+  /* A CANCEL that went out for it was ours, to free its id on a daemon
+   * that was shutting down; the user's own cancel ends a waiting job. */
+  j->cancelled = 0;
+  j->accepted = 0;
+  j->server_code = 0;
+  j->message[0] = '\0';
+  scc_drop_mesh(j);
+  j->ntri = j->nnormals = j->nvertices = j->ncomp = 0;
+  free(j->values);
+  j->values = NULL;
+  j->nvalues = 0;
+  j->t_first_chunk = j->last_download_report = 0;
+  if (c->in_use >= c->welcome.max_jobs) {
+    snprintf(j->message, sizeof j->message,
+             "LIMIT: the daemon reached on the retry takes %u jobs at once",
+             c->welcome.max_jobs);
+    j->client_done = j->server_done = 1;
+    scc_settle(c, j, SC_CLIENT_ELIMIT);
+    return;
+  }
+  j->id = free_id(c);
+  if (upload(c, j, j->xyz) < 0 && j->status == SC_CLIENT_PENDING &&
+      !j->resubmit) {
+    j->client_done = j->server_done = 1;
+    scc_settle(c, j, SC_CLIENT_ENOMEM);
+  }
+}
+
+unsigned sc_client_job_retries(const sc_client_job_t *job) {
+  return job ? job->retries_used : 0;
 }
 
 void sc_client_job_free(sc_client_job_t *job) {

@@ -84,9 +84,18 @@ void sc_client_params_init(sc_client_params_t *p) {
     else
       *(double *)f = v;
   }
+  p->retries = 0;
+  p->retry_backoff_ms = 100;
 }
 
 int scc_check_params(sc_client_t *c, const sc_client_params_t *p) {
+  if (p->retries < 0 || p->retries > 1000)
+    return scc_fail(c, SC_CLIENT_EINVAL, "retries must be 0 to 1000, got %d",
+                    p->retries);
+  if (p->retry_backoff_ms < 0 || p->retry_backoff_ms > 60000)
+    return scc_fail(c, SC_CLIENT_EINVAL,
+                    "retry_backoff_ms must be 0 to 60000, got %d",
+                    p->retry_backoff_ms);
   for (size_t i = 0; i < NROWS; ++i) {
     const scc_param_row_t *r = &rows[i];
     double v = get(p, r);

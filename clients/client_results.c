@@ -339,6 +339,18 @@ static void on_job_error(sc_client_t *c, const scp_frame_t *f) {
     scc_settle(c, j, j->local_err);
     return;
   }
+  if (m.code == SCP_WIRE_SHUTDOWN && scc_may_retry(j, SC_CLIENT_ESHUTDOWN)) {
+    /* The daemon is going away: the job runs again elsewhere once this
+     * connection is gone. The daemon closes it when its last job is over
+     * (PROTOCOL.md 8.5); with none left here, there is nothing to wait
+     * for. */
+    j->server_code = m.code;
+    j->resubmit = 1;
+    if (c->in_use == 0)
+      scc_conn_die(c, SC_CLIENT_ESHUTDOWN, "the daemon is shutting down: %s",
+                   m.message);
+    return;
+  }
   int code;
   if (j->cancelled || m.code == SCP_WIRE_CANCELLED)
     code = SC_CLIENT_ECANCELLED;
@@ -365,6 +377,7 @@ void scc_on_error(sc_client_t *c, const scp_frame_t *f) {
     int code = e.code == SCP_WIRE_VERSION    ? SC_CLIENT_EVERSION
                : e.code == SCP_WIRE_SHUTDOWN ? SC_CLIENT_ESHUTDOWN
                : e.code == SCP_WIRE_TIMEOUT  ? SC_CLIENT_ETIMEOUT
+               : e.code == SCP_WIRE_AUTH     ? SC_CLIENT_EAUTH
                                              : SC_CLIENT_ELOST;
     scc_conn_die(c, code, "the daemon closed the connection: %s: %s",
                  scp_wire_name(e.code), e.message);

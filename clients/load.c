@@ -41,6 +41,11 @@
 /* Verification failures described on stderr; the rest are only counted. */
 #define LOAD_SHOW_FAILURES 5
 #define LOAD_MAX_CODES 32
+/* A job is a pure function of its points and options: by default a job
+ * whose connection is lost runs again, and counts as lost only when it
+ * never completes. */
+#define LOAD_RETRIES 3
+#define LOAD_RETRY_BACKOFF_MS 200
 
 static const scs_surface_t surfaces[] = {SCS_SURF_SPHERE, SCS_SURF_TORUS,
                                          SCS_SURF_GENUS2};
@@ -53,7 +58,8 @@ typedef struct input {
 } input_t;
 
 typedef struct config {
-  const char *socket_path;
+  const char *socket_path; /* the address */
+  const char *token_file;
   unsigned clients;
   uint64_t jobs; /* UINT64_MAX: bounded by the duration only */
   unsigned in_flight;
@@ -75,6 +81,10 @@ typedef struct code_count {
 /* One thread's results. */
 typedef struct tally {
   uint64_t done, failed, points;
+  uint64_t retries;      /* resubmissions, in all */
+  uint64_t jobs_retried; /* jobs that needed at least one */
+  uint64_t lost;         /* jobs that never completed: their connection
+                            went, and their retries with it */
   double *latency_ms;
   size_t nlat, latcap;
   code_count_t codes[LOAD_MAX_CODES];
@@ -201,14 +211,38 @@ typedef struct slot {
   double t0;
 } slot_t;
 
+/* Whether a job that ended with rc lost its connection (and its retries)
+ * rather than failed on the daemon. */
+static int is_lost(int rc) {
+  return rc == SC_CLIENT_ELOST || rc == SC_CLIENT_ESHUTDOWN ||
+         rc == SC_CLIENT_ENODAEMON || rc == SC_CLIENT_ETIMEOUT;
+}
+
+static void sleep_ms(long ms) {
+  struct timespec ts = {.tv_sec = ms / 1000, .tv_nsec = (ms % 1000) * 1000000};
+  while (nanosleep(&ts, &ts) != 0 && errno == EINTR)
+    ;
+}
+
+/* Connects, trying again as the retry policy says when the daemon is gone
+ * or going (through a balancer, the next try may reach another). */
 static sc_client_t *connect_client(const config_t *cfg, tally_t *t,
                                    int *rc_out) {
   sc_client_options_t o;
   sc_client_options_init(&o);
   o.socket_path = cfg->socket_path;
+  o.token_file = cfg->token_file;
   sc_client_t *c = NULL;
   char msg[512];
-  *rc_out = sc_client_connect(&o, &c, msg, sizeof msg);
+  long wait = cfg->params.retry_backoff_ms;
+  for (int attempt = 0;; attempt++) {
+    *rc_out = sc_client_connect(&o, &c, msg, sizeof msg);
+    if (*rc_out == 0 || attempt >= cfg->params.retries || !is_lost(*rc_out))
+      break;
+    t->retries++;
+    sleep_ms(wait);
+    wait = wait * 2 > 10000 ? 10000 : wait * 2;
+  }
   if (*rc_out < 0 && !t->first_error[0])
     snprintf(t->first_error, sizeof t->first_error, "%s", msg);
   return c;
@@ -290,6 +324,11 @@ static void *run_worker(void *arg) {
       continue;
     }
     double ms = (now_s() - slots[k].t0) * 1e3;
+    unsigned retried = sc_client_job_retries(job);
+    t->retries += retried;
+    t->jobs_retried += retried > 0;
+    if (rc < 0 && is_lost(rc))
+      t->lost++;
     if (rc == 0) {
       t->done++;
       t->points += slots[k].in->n;
@@ -332,6 +371,7 @@ static sc_client_value_t *daemon_stats(const config_t *cfg, size_t *n) {
   sc_client_options_t o;
   sc_client_options_init(&o);
   o.socket_path = cfg->socket_path;
+  o.token_file = cfg->token_file;
   o.io_timeout_ms = 10000;
   sc_client_t *c = NULL;
   char msg[512];
@@ -368,7 +408,10 @@ static void usage(FILE *f) {
   char sock[256];
   fprintf(
       f,
-      "usage: shortcrust-load [--socket PATH] --clients C --jobs J\n"
+      "usage: shortcrust-load [--connect ADDR | --socket PATH] [--token-file "
+      "FILE]\n"
+      "                       [--retries N] [--retry-backoff MS] --clients C "
+      "--jobs J\n"
       "                       (--points N | --files F...) [--jobs-in-flight "
       "K]\n"
       "                       [--duration S] [--verify] [--json]\n\n"
@@ -380,7 +423,21 @@ static void usage(FILE *f) {
       "latency (from submit to the end of the job), errors by code and the\n"
       "daemon's counters before and after.\n\n"
       "options:\n"
-      "      --socket PATH       the daemon's socket (default %s)\n"
+      "      --connect ADDR      the daemon: tcp://HOST:PORT, unix://PATH or a "
+      "socket\n"
+      "                          path (default %s)\n"
+      "      --socket PATH       the same as --connect unix://PATH\n"
+      "      --token-file FILE   the token of a daemon on TCP (default: the "
+      "variable\n"
+      "                          SHORTCRUST_TOKEN)\n"
+      "      --retries N         submit a job again up to N times when its "
+      "connection\n"
+      "                          is lost or the daemon shuts down; connect "
+      "again as\n"
+      "                          often (default %d)\n"
+      "      --retry-backoff MS  wait MS ms before the first retry, twice as "
+      "long\n"
+      "                          before each next one (default %d)\n"
       "  -c, --clients C         connections, one thread each (default 1)\n"
       "  -n, --jobs J            jobs in all; optional with --duration\n"
       "  -p, --points N          points per generated sample, at least 100\n"
@@ -405,7 +462,8 @@ static void usage(FILE *f) {
       "  -V, --version           the version\n\n"
       "Exit status: 0 every job done (and verified), 1 errors or "
       "verification\nfailures, 2 bad command line.\n",
-      LOAD_SAMPLES, sc_client_default_socket(sock, sizeof sock));
+      LOAD_SAMPLES, sc_client_default_socket(sock, sizeof sock), LOAD_RETRIES,
+      LOAD_RETRY_BACKOFF_MS);
 }
 
 static int parse_u64(const char *opt, const char *arg, uint64_t min,
@@ -434,10 +492,24 @@ static int parse_seconds(const char *opt, const char *arg, double *out) {
   return 0;
 }
 
-enum { OPT_SOCKET = 256, OPT_TIMEOUT, OPT_MODE, OPT_R, OPT_VERIFY, OPT_JSON };
+enum {
+  OPT_SOCKET = 256,
+  OPT_TOKEN_FILE,
+  OPT_RETRIES,
+  OPT_RETRY_BACKOFF,
+  OPT_TIMEOUT,
+  OPT_MODE,
+  OPT_R,
+  OPT_VERIFY,
+  OPT_JSON
+};
 
 static const struct option long_options[] = {
     {"socket", required_argument, NULL, OPT_SOCKET},
+    {"connect", required_argument, NULL, OPT_SOCKET},
+    {"token-file", required_argument, NULL, OPT_TOKEN_FILE},
+    {"retries", required_argument, NULL, OPT_RETRIES},
+    {"retry-backoff", required_argument, NULL, OPT_RETRY_BACKOFF},
     {"clients", required_argument, NULL, 'c'},
     {"jobs", required_argument, NULL, 'n'},
     {"points", required_argument, NULL, 'p'},
@@ -466,6 +538,19 @@ static int parse_args(int argc, char **argv, config_t *cfg,
     switch (c) {
     case OPT_SOCKET:
       cfg->socket_path = optarg;
+      break;
+    case OPT_TOKEN_FILE:
+      cfg->token_file = optarg;
+      break;
+    case OPT_RETRIES:
+      if (parse_u64("--retries", optarg, 0, 1000, &v) < 0)
+        return 2;
+      cfg->params.retries = (int)v;
+      break;
+    case OPT_RETRY_BACKOFF:
+      if (parse_u64("--retry-backoff", optarg, 0, 60000, &v) < 0)
+        return 2;
+      cfg->params.retry_backoff_ms = (int)v;
       break;
     case 'c':
       if (parse_u64("--clients", optarg, 1, 1000, &v) < 0)
@@ -657,6 +742,9 @@ static void merge_tallies(const worker_t *w, unsigned started, tally_t *all) {
         all->codes[j].count += t->codes[k].count;
     }
     all->failed += t->failed;
+    all->retries += t->retries;
+    all->jobs_retried += t->jobs_retried;
+    all->lost += t->lost;
     if (!all->first_error[0] && t->first_error[0])
       snprintf(all->first_error, sizeof all->first_error, "%s",
                t->first_error);
@@ -724,6 +812,10 @@ static void print_text(const config_t *cfg, const summary_t *s) {
          s->points_per_s);
   printf("latency     p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms\n",
          s->p50, s->p90, s->p99, s->pmax);
+  printf("retries     %llu, %llu job%s retried, %llu lost\n",
+         (unsigned long long)all->retries,
+         (unsigned long long)all->jobs_retried,
+         all->jobs_retried == 1 ? "" : "s", (unsigned long long)all->lost);
   printf("errors      ");
   if (all->ncodes == 0)
     printf("none\n");
@@ -761,7 +853,10 @@ static void print_json(const config_t *cfg, const summary_t *s) {
     scf_json_string(stdout, all->codes[k].name);
     printf(": %llu", (unsigned long long)all->codes[k].count);
   }
-  printf("}, \"verify\": %s, \"verified\": %llu, \"verify_failures\": %llu, "
+  printf("}, \"retries\": %llu, \"jobs_retried\": %llu, \"jobs_lost\": %llu",
+         (unsigned long long)all->retries,
+         (unsigned long long)all->jobs_retried, (unsigned long long)all->lost);
+  printf(", \"verify\": %s, \"verified\": %llu, \"verify_failures\": %llu, "
          "\"seconds\": %.6f, \"jobs_per_s\": %.6f, \"points_per_s\": %.3f, "
          "\"latency_p50_ms\": %.3f, \"latency_p90_ms\": %.3f, "
          "\"latency_p99_ms\": %.3f, \"latency_max_ms\": %.3f, "
@@ -783,6 +878,8 @@ int main(int argc, char **argv) {
   cfg.jobs = 0;
   cfg.timeout = 300;
   sc_client_params_init(&cfg.params);
+  cfg.params.retries = LOAD_RETRIES;
+  cfg.params.retry_backoff_ms = LOAD_RETRY_BACKOFF_MS;
   uint64_t points = 0;
   const char **files = calloc((size_t)argc + 1, sizeof *files);
   size_t nfiles = 0;

@@ -1,6 +1,7 @@
 /*
  * The shortcrust client library: talks to shortcrustd over its Unix socket
- * (proto/PROTOCOL.md) so that a program can have meshes reconstructed
+ * or over TCP (proto/PROTOCOL.md) so that a program can have meshes
+ * reconstructed
  * without linking the core. Plain C; nothing of libuv, the core or the
  * protocol codec shows through this header.
  *
@@ -50,7 +51,7 @@ extern "C" {
 #endif
 
 /*
- * Error codes, in a range of their own (-201 to -215) so that a program can
+ * Error codes, in a range of their own (-201 to -216) so that a program can
  * report them next to the core's and the file module's codes. Every call
  * that fails returns one; the handle (or the job, for a job's own end)
  * keeps a one-line message that says more.
@@ -70,7 +71,8 @@ extern "C" {
   X(SHUTDOWN, -212, "the daemon is shutting down")                             \
   X(FILE, -213, "cannot read the point file")                                  \
   X(STATE, -214, "call not allowed now")                                       \
-  X(LIMIT, -215, "too many jobs in use on this connection")
+  X(LIMIT, -215, "too many jobs in use on this connection")                    \
+  X(AUTH, -216, "the daemon refused the token, or there is none to send")
 
 typedef enum sc_client_err {
   SC_CLIENT_OK = 0,
@@ -112,7 +114,9 @@ const char *sc_client_stage_name(uint32_t stage);
 char *sc_client_default_socket(char *buf, size_t len);
 
 typedef struct sc_client_options {
-  /* The daemon's socket; NULL for the default above. */
+  /* The daemon's address: a Unix socket's path, "unix://PATH", or
+   * "tcp://HOST:PORT" (HOST a name, an IPv4 address or an IPv6 address in
+   * brackets); NULL for the default socket above. */
   const char *socket_path;
   /* How long connecting and the handshake may take, and how long a write
    * may wait for the daemon to take more bytes, in milliseconds. A write
@@ -122,6 +126,13 @@ typedef struct sc_client_options {
   /* The largest frame this client accepts, in bytes; the handshake may
    * agree on less. Default 1 MiB; at least 4096. */
   uint32_t max_frame;
+  /* The token a daemon on TCP requires (PROTOCOL.md 5.1), from the first
+   * of: token (a NUL-terminated string), token_file (its one line, the
+   * line end not included; the file must be open to its owner only, as
+   * the daemon's), the environment variable SHORTCRUST_TOKEN. Sent over
+   * TCP only: a Unix socket needs none. Default NULL for both. */
+  const char *token;
+  const char *token_file;
 } sc_client_options_t;
 
 void sc_client_options_init(sc_client_options_t *o);
@@ -138,7 +149,10 @@ typedef struct sc_client_job sc_client_job_t;
  * connect (permissions, a path too long), SC_CLIENT_EVERSION when the daemon
  * has no protocol version in common with this library, SC_CLIENT_ESHUTDOWN
  * when it is shutting down, SC_CLIENT_EPROTOCOL for a peer that does not
- * speak the protocol, SC_CLIENT_ETIMEOUT, SC_CLIENT_ELOST.
+ * speak the protocol, SC_CLIENT_EAUTH when a daemon on TCP refused the
+ * token (or there was none to send, or the token file cannot be used),
+ * SC_CLIENT_EINVAL for an address that is not one, SC_CLIENT_ETIMEOUT,
+ * SC_CLIENT_ELOST.
  */
 int sc_client_connect(const sc_client_options_t *opts, sc_client_t **out,
                       char *msg, size_t msg_len);
@@ -157,7 +171,7 @@ const char *sc_client_last_error(const sc_client_t *c);
 
 /* What the handshake agreed on. */
 typedef struct sc_client_info {
-  const char *socket_path;
+  const char *socket_path; /* the address, as given */
   uint32_t version;
   uint32_t max_frame;
   uint32_t max_jobs;   /* jobs in use at once on this connection */
@@ -250,6 +264,26 @@ typedef struct sc_client_params {
    * the job collects it for sc_client_job_mesh(). */
   sc_client_chunk_fn chunk;
   void *chunk_user;
+  /*
+   * Retries. A job is a pure function of its points and parameters, so a
+   * job whose connection is lost before its end (SC_CLIENT_ELOST: the
+   * daemon died, a proxy dropped it) or whose daemon shut down
+   * (SC_CLIENT_ESHUTDOWN) can be run again: the handle connects anew to
+   * the same address (through a balancer, perhaps to another daemon) and
+   * submits it again, up to `retries` times, waiting retry_backoff_ms
+   * before the first attempt and twice as long before each next one
+   * (capped at 10 s). Every job of the handle with retries left goes
+   * along; the others end with the error. A failed attempt to connect
+   * counts as a retry. sc_client_job_retries() says how many a job took.
+   *
+   * Default 0 (no retries) and 100 ms. With retries, the points given to
+   * sc_client_submit() must stay valid and unchanged until the job has
+   * ended (sc_client_submit_file() keeps its own), and the callbacks may
+   * see the job again from the start: progress from the upload on, and
+   * chunks from the first one.
+   */
+  int retries;
+  int retry_backoff_ms;
 } sc_client_params_t;
 
 void sc_client_params_init(sc_client_params_t *p);
@@ -319,6 +353,9 @@ const char *sc_client_job_message(const sc_client_job_t *job);
 /* The daemon's error code for a job it refused or that failed on it
  * (PROTOCOL.md section 9; sc_client_server_code_name() names it), else 0. */
 uint32_t sc_client_job_server_code(const sc_client_job_t *job);
+/* How many times the job was submitted again after losing its connection
+ * (sc_client_params_t.retries): 0 when its first run ended it. */
+unsigned sc_client_job_retries(const sc_client_job_t *job);
 /* The points of a job submitted from a file (3 * *n doubles), else NULL. */
 const double *sc_client_job_points(const sc_client_job_t *job, uint64_t *n);
 

@@ -28,6 +28,7 @@
 #include "daemon.h"
 #include "log.h"
 
+#include <arpa/inet.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -125,11 +126,18 @@ void scd_conn_close_now(scd_conn_t *c, const char *reason) {
     c->srv->conns_open--;
     c->counted = 0;
   }
-  scd_info("conn %llu: closed (%s): %llu bytes in, %llu bytes out, %llu "
-           "jobs, %.1f s",
-           (ull)c->id, c->close_reason, (ull)c->bytes_in, (ull)c->bytes_out,
-           (ull)c->jobs_total, scd_ms_between(c->open_ns, uv_hrtime()) / 1e3);
-  uv_close((uv_handle_t *)&c->pipe, on_closed);
+  /* A balancer's health check opens a TCP connection every second or so,
+   * and runs no job: those come and go at debug level, so that the log
+   * keeps the clients' connections (a refused token is a warning). */
+  int quiet = c->tcp && c->jobs_total == 0 &&
+              strcmp(c->close_reason, "closed by the client") == 0;
+  scd_log(quiet ? SCD_LOG_DEBUG : SCD_LOG_INFO,
+          "conn %llu: closed (%s): %s%s%llu bytes in, %llu bytes out, %llu "
+          "jobs, %.1f s",
+          (ull)c->id, c->close_reason, c->tcp ? c->peer : "",
+          c->tcp ? " over TCP, " : "", (ull)c->bytes_in, (ull)c->bytes_out,
+          (ull)c->jobs_total, scd_ms_between(c->open_ns, uv_hrtime()) / 1e3);
+  uv_close(&c->h.handle, on_closed);
 }
 
 static void on_shutdown(uv_shutdown_t *req, int status) {
@@ -143,7 +151,7 @@ static void finish_closing(scd_conn_t *c) {
   if (c->state != SCD_CONN_CLOSING || c->writing || c->out.len)
     return;
   c->sreq.data = c;
-  if (uv_shutdown(&c->sreq, (uv_stream_t *)&c->pipe, on_shutdown) != 0)
+  if (uv_shutdown(&c->sreq, &c->h.stream, on_shutdown) != 0)
     scd_conn_close_now(c, c->close_reason);
 }
 
@@ -162,7 +170,9 @@ void scd_conn_fatal(scd_conn_t *c, uint32_t code, uint32_t job_id,
   va_start(ap, fmt);
   scd_vformat(e.message, sizeof e.message, fmt, ap);
   va_end(ap);
-  if (code != SCP_WIRE_SHUTDOWN)
+  if (code == SCP_WIRE_AUTH)
+    c->srv->n.auth_refused_total++;
+  else if (code != SCP_WIRE_SHUTDOWN)
     c->srv->n.protocol_errors_total++;
   scd_log(code == SCP_WIRE_SHUTDOWN ? SCD_LOG_INFO : SCD_LOG_WARN,
           "conn %llu: fatal ERROR %s: %s", (ull)c->id, scp_wire_name(code),
@@ -229,10 +239,10 @@ static void on_read(uv_stream_t *s, ssize_t nread, const uv_buf_t *buf) {
 
 static void set_reading(scd_conn_t *c, int on) {
   if (on && !c->reading && live(c)) {
-    if (uv_read_start((uv_stream_t *)&c->pipe, on_alloc, on_read) == 0)
+    if (uv_read_start(&c->h.stream, on_alloc, on_read) == 0)
       c->reading = 1;
   } else if (!on && c->reading) {
-    uv_read_stop((uv_stream_t *)&c->pipe);
+    uv_read_stop(&c->h.stream);
     c->reading = 0;
   }
 }
@@ -288,7 +298,7 @@ void scd_conn_flush(scd_conn_t *c) {
   uv_buf_t ub = uv_buf_init((char *)c->wbuf.data, (unsigned)c->wbuf.len);
   c->wreq.data = c;
   c->writing = 1;
-  int rc = uv_write(&c->wreq, (uv_stream_t *)&c->pipe, &ub, 1, on_write);
+  int rc = uv_write(&c->wreq, &c->h.stream, &ub, 1, on_write);
   if (rc != 0) {
     c->writing = 0;
     char why[96];
@@ -321,6 +331,8 @@ static void on_hello(scd_conn_t *c, const scp_frame_t *f) {
                    scp_strerror(rc));
     return;
   }
+  if (!scd_auth_hello(c, &h))
+    return;
   if (srv->shutting_down) {
     scd_conn_fatal(c, SCP_WIRE_SHUTDOWN, 0, 0, "server shutting down");
     return;
@@ -328,7 +340,7 @@ static void on_hello(scd_conn_t *c, const scp_frame_t *f) {
   scp_welcome_t w;
   memset(&w, 0, sizeof w);
   w.version = SCP_VERSION;
-  w.features = h.features & SCP_FEATURE_JOB_OPTIONS;
+  w.features = h.features & (SCP_FEATURE_JOB_OPTIONS | SCP_FEATURE_TOKEN);
   w.max_frame = h.max_frame < srv->cfg.max_frame ? h.max_frame
                                                  : srv->cfg.max_frame;
   w.max_jobs = srv->cfg.max_jobs;
@@ -341,8 +353,9 @@ static void on_hello(scd_conn_t *c, const scp_frame_t *f) {
   c->out.max_frame = c->wbuf.max_frame = w.max_frame;
   c->state = SCD_CONN_READY;
   c->deadline_ns = 0;
-  scd_info("conn %llu: ready (version %u, max_frame %u)", (ull)c->id,
-           w.version, w.max_frame);
+  scd_log(c->tcp ? SCD_LOG_DEBUG : SCD_LOG_INFO,
+          "conn %llu: ready (version %u, max_frame %u)", (ull)c->id, w.version,
+          w.max_frame);
 }
 
 static void handle_frame(scd_conn_t *c, const scp_frame_t *f) {
@@ -482,15 +495,38 @@ void scd_conn_tick(scd_conn_t *c, uint64_t now) {
   }
 }
 
-void scd_conn_accept(scd_server_t *srv) {
+/* The TCP peer's address as text, for the logs. */
+static void peer_name(scd_conn_t *c) {
+  struct sockaddr_storage ss;
+  int len = sizeof ss;
+  char host[48] = "?";
+  int port = 0;
+  if (uv_tcp_getpeername(&c->h.tcp, (struct sockaddr *)&ss, &len) == 0) {
+    if (ss.ss_family == AF_INET6) {
+      uv_ip6_name((struct sockaddr_in6 *)&ss, host, sizeof host);
+      port = ntohs(((struct sockaddr_in6 *)&ss)->sin6_port);
+    } else {
+      uv_ip4_name((struct sockaddr_in *)&ss, host, sizeof host);
+      port = ntohs(((struct sockaddr_in *)&ss)->sin_port);
+    }
+  }
+  snprintf(c->peer, sizeof c->peer, strchr(host, ':') ? "[%s]:%d" : "%s:%d",
+           host, port);
+}
+
+void scd_conn_accept(scd_server_t *srv, uv_stream_t *listener, int tcp) {
   scd_conn_t *c = calloc(1, sizeof *c);
   if (!c) {
     scd_error("out of memory for a connection");
     return;
   }
   c->srv = srv;
-  uv_pipe_init(srv->loop, &c->pipe, 0);
-  c->pipe.data = c;
+  c->tcp = tcp;
+  if (tcp)
+    uv_tcp_init(srv->loop, &c->h.tcp);
+  else
+    uv_pipe_init(srv->loop, &c->h.pipe, 0);
+  c->h.handle.data = c;
   c->next = srv->conns;
   if (srv->conns)
     srv->conns->prev = c;
@@ -501,11 +537,18 @@ void scd_conn_accept(scd_server_t *srv) {
   c->max_frame = SCP_FRAME_MIN;
   scp_buf_init(&c->out, SCP_FRAME_MIN);
   scp_buf_init(&c->wbuf, SCP_FRAME_MIN);
-  int rc = uv_accept((uv_stream_t *)&srv->listener, (uv_stream_t *)&c->pipe);
+  int rc = uv_accept(listener, &c->h.stream);
   if (rc != 0) {
     scd_warn("accept: %s", uv_strerror(rc));
     scd_conn_close_now(c, "accept failed");
     return;
+  }
+  if (tcp) {
+    /* Frames are written whole, so Nagle's delay only adds latency to the
+     * small ones (ACCEPTED, PROGRESS, PONG). */
+    uv_tcp_nodelay(&c->h.tcp, 1);
+    uv_tcp_keepalive(&c->h.tcp, 1, 60);
+    peer_name(c);
   }
   scp_limits_t lim;
   scp_limits_init(&lim);
@@ -528,6 +571,10 @@ void scd_conn_accept(scd_server_t *srv) {
   c->counted = 1;
   srv->conns_open++;
   c->deadline_ns = c->open_ns + srv->cfg.handshake_ms * 1000000u;
-  scd_info("conn %llu: accepted (%u open)", (ull)c->id, srv->conns_open);
+  if (tcp)
+    scd_debug("conn %llu: accepted from %s over TCP (%u open)", (ull)c->id,
+              c->peer, srv->conns_open);
+  else
+    scd_info("conn %llu: accepted (%u open)", (ull)c->id, srv->conns_open);
   set_reading(c, 1);
 }

@@ -18,10 +18,16 @@
 #include "scproto.h"
 #include "shortcrust.h"
 
+/* TCP listeners one daemon may have (--listen, repeated). */
+#define SCD_MAX_LISTEN 8
+
 typedef struct scd_config {
   /* Flags. */
   const char *socket_path;  /* never NULL once main() is done with it */
   unsigned socket_mode;     /* default 0660 */
+  const char *listen[SCD_MAX_LISTEN]; /* --listen tcp://HOST:PORT */
+  unsigned nlisten;
+  const char *token_file;   /* --token-file; required with --listen */
   unsigned workers;         /* default: available cores */
   unsigned max_connections; /* default 64 */
   unsigned max_jobs;        /* per connection; default 16 */
@@ -61,10 +67,19 @@ typedef struct scd_counters {
   uint64_t frames_out_total;
   uint64_t protocol_errors_total;
   uint64_t slow_readers_closed_total;
+  uint64_t auth_refused_total;
 } scd_counters_t;
 
 typedef struct scd_conn scd_conn_t;
 typedef struct scd_job scd_job_t;
+
+/* A TCP listener: its handle and the address it is bound to. */
+typedef struct scd_tcp_listener {
+  uv_tcp_t tcp;
+  struct scd_server *srv;
+  int open;
+  char name[SCP_ADDR_HOST_MAX + 16]; /* tcp://HOST:PORT, the port bound */
+} scd_tcp_listener_t;
 
 typedef struct scd_server {
   uv_loop_t *loop;
@@ -72,6 +87,12 @@ typedef struct scd_server {
 
   uv_pipe_t listener;
   int listener_open;
+  scd_tcp_listener_t tcp[SCD_MAX_LISTEN];
+  unsigned ntcp;
+  /* The token TCP clients must send (PROTOCOL.md 5.1); token_len 0 when
+   * there is none, which is only allowed without TCP listeners. */
+  uint8_t token[SCP_TOKEN_MAX];
+  size_t token_len;
   char socket_path[256];   /* as bound or as systemd gave it */
   int unlink_at_exit;      /* we created the socket file */
   int lock_fd;             /* held for the daemon's life; -1 when none */
@@ -134,7 +155,17 @@ enum {
 };
 
 struct scd_conn {
-  uv_pipe_t pipe;
+  /* The client's stream: a Unix socket or TCP. The handle comes first, so
+   * libuv's callbacks find the connection through its data field either
+   * way. */
+  union {
+    uv_pipe_t pipe;
+    uv_tcp_t tcp;
+    uv_stream_t stream;
+    uv_handle_t handle;
+  } h;
+  int tcp;       /* 1: came in over TCP and needs the token */
+  char peer[64]; /* the TCP peer's address, for the logs */
   scd_server_t *srv;
   scd_conn_t *prev, *next;
   uint64_t id;
@@ -174,7 +205,8 @@ void scd_server_free_task(scd_server_t *srv, scd_task_t *t);
 void scd_server_stats(scd_server_t *srv, scp_buf_t *b, uint32_t tag);
 
 /* conn.c */
-void scd_conn_accept(scd_server_t *srv);
+/* Accepts a client on a listener: the Unix socket (tcp 0) or a TCP one. */
+void scd_conn_accept(scd_server_t *srv, uv_stream_t *listener, int tcp);
 void scd_conn_task_event(scd_server_t *srv, scd_task_t *t, unsigned events,
                          uint32_t stage, double fraction);
 /* Shutdown: stop queued jobs (grace_over 0) or every job (1), and close
@@ -187,6 +219,20 @@ size_t scd_conn_queued(const scd_conn_t *c);
 
 /* listen.c */
 int scd_listen_open(scd_server_t *srv);
+/* Binds every --listen address; -1 (logged) when one cannot be bound. */
+int scd_listen_tcp(scd_server_t *srv);
+/* Stops accepting on every listener. */
+void scd_listen_close(scd_server_t *srv);
 void scd_listen_cleanup(scd_server_t *srv);
+
+/* auth.c */
+/* Reads --token-file into srv->token: -1 (logged) when the file is missing,
+ * not a regular file, open to group or others, or holds no usable token. */
+int scd_token_load(scd_server_t *srv, const char *path);
+/* Wipes the token from memory, at exit. */
+void scd_token_forget(scd_server_t *srv);
+/* Whether HELLO may go on: 1 on a Unix socket (the token is ignored) or
+ * with the right token on TCP; 0 after a fatal ERROR AUTH. */
+int scd_auth_hello(scd_conn_t *c, const scp_hello_t *h);
 
 #endif /* SCD_DAEMON_H */

@@ -1,7 +1,8 @@
 /*
- * The listening socket: taken from systemd (LISTEN_FDS) or bound at
- * --socket with its mode, replacing a stale socket file and refusing to
- * start when another daemon is alive on the path.
+ * The listening sockets: the Unix socket, taken from systemd (LISTEN_FDS)
+ * or bound at --socket with its mode, replacing a stale socket file and
+ * refusing to start when another daemon is alive on the path; and the TCP
+ * listeners of --listen, whose clients must send the token (auth.c).
  *
  * Two daemons started at once must not both decide that the file is stale
  * and unlink each other's sockets, so the check and the bind happen while
@@ -13,8 +14,10 @@
 #include "daemon.h"
 #include "log.h"
 
+#include <arpa/inet.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <netdb.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -238,6 +241,81 @@ int scd_listen_open(scd_server_t *srv) {
   srv->listener_open = 1;
   srv->listener.data = srv;
   return 0;
+}
+
+static void on_tcp_connection(uv_stream_t *listener, int status) {
+  scd_tcp_listener_t *l = listener->data;
+  if (status < 0) {
+    scd_warn("accept on %s: %s", l->name, uv_strerror(status));
+    return;
+  }
+  scd_conn_accept(l->srv, listener, 1);
+}
+
+/* Resolves, binds and listens on one tcp:// address. */
+static int bind_tcp(scd_server_t *srv, scd_tcp_listener_t *l,
+                    const char *text) {
+  scp_address_t a;
+  if (scp_address_parse(text, &a) != 0 || a.kind != SCP_ADDR_TCP) {
+    scd_error("--listen %s: want tcp://HOST:PORT", text);
+    return -1;
+  }
+  char port[8];
+  snprintf(port, sizeof port, "%u", (unsigned)a.port);
+  struct addrinfo hints, *res = NULL;
+  memset(&hints, 0, sizeof hints);
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+  int rc = getaddrinfo(a.host, port, &hints, &res);
+  if (rc != 0 || !res) {
+    scd_error("--listen %s: cannot resolve %s: %s", text, a.host,
+              gai_strerror(rc));
+    return -1;
+  }
+  uv_tcp_init(srv->loop, &l->tcp);
+  l->tcp.data = l;
+  l->srv = srv;
+  l->open = 1;
+  srv->ntcp++;
+  /* The first address the name gives; a name with several is better
+   * given as the literal wanted. */
+  int urc = uv_tcp_bind(&l->tcp, res->ai_addr, 0);
+  freeaddrinfo(res);
+  if (urc == 0)
+    urc = uv_listen((uv_stream_t *)&l->tcp, SOMAXCONN, on_tcp_connection);
+  if (urc != 0) {
+    scd_error("cannot listen on %s: %s", text, uv_strerror(urc));
+    return -1;
+  }
+  /* With port 0 the system chose one: name the listener by it. */
+  struct sockaddr_storage ss;
+  int len = sizeof ss;
+  if (uv_tcp_getsockname(&l->tcp, (struct sockaddr *)&ss, &len) == 0)
+    a.port =
+        ntohs(ss.ss_family == AF_INET6 ? ((struct sockaddr_in6 *)&ss)->sin6_port
+                                       : ((struct sockaddr_in *)&ss)->sin_port);
+  scp_address_format(&a, l->name, sizeof l->name);
+  return 0;
+}
+
+int scd_listen_tcp(scd_server_t *srv) {
+  for (unsigned i = 0; i < srv->cfg.nlisten; i++)
+    if (bind_tcp(srv, &srv->tcp[i], srv->cfg.listen[i]) != 0)
+      return -1;
+  return 0;
+}
+
+void scd_listen_close(scd_server_t *srv) {
+  if (srv->listener_open) {
+    uv_close((uv_handle_t *)&srv->listener, NULL);
+    srv->listener_open = 0;
+  }
+  for (unsigned i = 0; i < srv->ntcp; i++)
+    if (srv->tcp[i].open) {
+      uv_close((uv_handle_t *)&srv->tcp[i].tcp, NULL);
+      srv->tcp[i].open = 0;
+    }
 }
 
 void scd_listen_cleanup(scd_server_t *srv) {

@@ -46,7 +46,8 @@ static void usage(FILE *f, const scd_config_t *d) {
   fprintf(f,
           "Usage: shortcrustd [OPTION]...\n"
           "Reconstruct triangle meshes from point clouds for clients on a "
-          "Unix socket.\n"
+          "Unix socket,\n"
+          "and on TCP with a shared token.\n"
           "\n"
           "  --socket PATH          listen on PATH (default:\n"
           "                         $XDG_RUNTIME_DIR/shortcrust.sock, else\n"
@@ -56,6 +57,16 @@ static void usage(FILE *f, const scd_config_t *d) {
           "activation\n"
           "  --socket-mode MODE     permissions of the socket file, in octal "
           "(default 0660)\n"
+          "  --listen tcp://HOST:PORT\n"
+          "                         also accept clients over TCP there "
+          "(repeatable, up to\n"
+          "                         %d; port 0 picks a free one, logged); "
+          "needs --token-file\n"
+          "  --token-file FILE      the token TCP clients must send: one "
+          "line of 16 to 1024\n"
+          "                         bytes in a file only its owner may "
+          "read (mode 0600 or\n"
+          "                         0400); Unix socket clients need none\n"
           "  --workers N            reconstruction threads (default: the "
           "number of cores,\n"
           "                         here %u)\n"
@@ -84,8 +95,8 @@ static void usage(FILE *f, const scd_config_t *d) {
           "remove the\n"
           "socket file and exit 0; a second signal ends the grace period at "
           "once.\n",
-          socket_default(), d->workers, d->max_connections, d->max_jobs,
-          (unsigned long long)d->max_points,
+          socket_default(), SCD_MAX_LISTEN, d->workers, d->max_connections,
+          d->max_jobs, (unsigned long long)d->max_points,
           (unsigned long long)d->memory_budget, d->grace);
 }
 
@@ -147,6 +158,8 @@ static int parse_bytes(const char *s, uint64_t *out) {
 enum {
   OPT_SOCKET = 256,
   OPT_SOCKET_MODE,
+  OPT_LISTEN,
+  OPT_TOKEN_FILE,
   OPT_WORKERS,
   OPT_MAX_CONNECTIONS,
   OPT_MAX_JOBS,
@@ -163,6 +176,8 @@ static int parse_args(int argc, char **argv, scd_config_t *cfg) {
   static const struct option opts[] = {
       {"socket", required_argument, NULL, OPT_SOCKET},
       {"socket-mode", required_argument, NULL, OPT_SOCKET_MODE},
+      {"listen", required_argument, NULL, OPT_LISTEN},
+      {"token-file", required_argument, NULL, OPT_TOKEN_FILE},
       {"workers", required_argument, NULL, OPT_WORKERS},
       {"max-connections", required_argument, NULL, OPT_MAX_CONNECTIONS},
       {"max-jobs", required_argument, NULL, OPT_MAX_JOBS},
@@ -195,6 +210,21 @@ static int parse_args(int argc, char **argv, scd_config_t *cfg) {
       cfg->socket_mode = (unsigned)m;
       break;
     }
+    case OPT_LISTEN: {
+      scp_address_t a;
+      if (scp_address_parse(optarg, &a) != 0 || a.kind != SCP_ADDR_TCP)
+        return bad_value("--listen", optarg,
+                         "want tcp://HOST:PORT (the Unix socket is --socket)");
+      if (cfg->nlisten == SCD_MAX_LISTEN)
+        return bad_value("--listen", optarg, "too many TCP listeners");
+      cfg->listen[cfg->nlisten++] = optarg;
+      break;
+    }
+    case OPT_TOKEN_FILE:
+      if (!*optarg)
+        return bad_value("--token-file", optarg, "an empty path");
+      cfg->token_file = optarg;
+      break;
     case OPT_WORKERS:
       if (parse_u64(optarg, 1, 1024, &v))
         return bad_value("--workers", optarg, "want 1 to 1024");
@@ -256,6 +286,14 @@ static int parse_args(int argc, char **argv, scd_config_t *cfg) {
   if (optind < argc) {
     fprintf(stderr, "shortcrustd: unexpected argument '%s'\n", argv[optind]);
     fprintf(stderr, "Try 'shortcrustd --help'.\n");
+    return -1;
+  }
+  if (cfg->nlisten && !cfg->token_file) {
+    /* Anyone who can reach the port could use the daemon otherwise. */
+    fprintf(stderr,
+            "shortcrustd: --listen %s needs --token-file: TCP "
+            "clients must send a shared token\n",
+            cfg->listen[0]);
     return -1;
   }
   if (!cfg->socket_path)

@@ -95,7 +95,7 @@ void scd_server_free_task(scd_server_t *srv, scd_task_t *t) {
  *   points_in_total             points received
  *   triangles_out_total         triangles of the meshes delivered
  *   bytes_in_total, bytes_out_total, frames_in_total, frames_out_total
- *   protocol_errors_total       fatal ERRORs sent, SHUTDOWN aside
+ *   protocol_errors_total       fatal ERRORs sent, SHUTDOWN and AUTH aside
  *   slow_readers_closed_total   connections closed for not reading
  *   queue_depth                 jobs waiting for a worker
  *   workers, workers_busy       the pool, and the workers running a job
@@ -105,6 +105,8 @@ void scd_server_free_task(scd_server_t *srv, scd_task_t *t) {
  *   output_queued_bytes         output waiting to be written, all
  *                               connections together
  *   shutting_down               1 once SIGTERM or SIGINT came
+ *   auth_refused_total          TCP connections refused with AUTH: no
+ *                               token, or a wrong one
  */
 void scd_server_stats(scd_server_t *srv, scp_buf_t *b, uint32_t tag) {
   scd_pool_stats_t ps;
@@ -140,6 +142,7 @@ void scd_server_stats(scd_server_t *srv, scp_buf_t *b, uint32_t tag) {
       U64("memory_budget_bytes", srv->cfg.memory_budget),
       U64("output_queued_bytes", out_queued),
       U64("shutting_down", srv->shutting_down),
+      U64("auth_refused_total", n->auth_refused_total),
   };
 #undef U64
   scp_enc_stats(b, tag, v, (uint32_t)(sizeof v / sizeof v[0]));
@@ -175,8 +178,6 @@ static void end_grace(scd_server_t *srv) {
   scd_server_maybe_finish(srv);
 }
 
-static void on_listener_closed(uv_handle_t *h) { (void)h; }
-
 static void on_grace(uv_timer_t *h) { end_grace(h->data); }
 
 static void begin_shutdown(scd_server_t *srv, const char *why) {
@@ -193,10 +194,7 @@ static void begin_shutdown(scd_server_t *srv, const char *why) {
   scd_info("%s: shutting down (%u connections, %llu jobs; grace %.3g s)", why,
            srv->conns_open, (unsigned long long)srv->tasks_live,
            srv->cfg.grace);
-  if (srv->listener_open) {
-    uv_close((uv_handle_t *)&srv->listener, on_listener_closed);
-    srv->listener_open = 0;
-  }
+  scd_listen_close(srv);
   scd_listen_cleanup(srv);
   for (scd_conn_t *c = srv->conns, *next; c; c = next) {
     next = c->next;
@@ -232,7 +230,7 @@ static void on_connection(uv_stream_t *listener, int status) {
     scd_warn("accept: %s", uv_strerror(status));
     return;
   }
-  scd_conn_accept(srv);
+  scd_conn_accept(srv, listener, 0);
 }
 
 static void on_task_event(void *arg, scd_task_t *t, unsigned events,
@@ -278,6 +276,10 @@ int scd_server_run(const scd_config_t *cfg) {
     return 1;
   }
   srv->max_points = cfg->max_points < fit ? cfg->max_points : fit;
+  if (cfg->token_file && scd_token_load(srv, cfg->token_file) != 0) {
+    free(srv);
+    return 1;
+  }
 
   /* A client that goes away while we write must not kill the daemon. */
   signal(SIGPIPE, SIG_IGN);
@@ -290,8 +292,12 @@ int scd_server_run(const scd_config_t *cfg) {
   int urc = uv_listen((uv_stream_t *)&srv->listener, SOMAXCONN, on_connection);
   if (urc != 0) {
     scd_error("listen on %s: %s", srv->socket_path, uv_strerror(urc));
-    uv_close((uv_handle_t *)&srv->listener, NULL);
-    srv->listener_open = 0;
+    scd_listen_close(srv);
+    rc = 1;
+    goto out_loop;
+  }
+  if (scd_listen_tcp(srv) != 0) {
+    scd_listen_close(srv);
     rc = 1;
     goto out_loop;
   }
@@ -299,8 +305,7 @@ int scd_server_run(const scd_config_t *cfg) {
                      srv, &srv->pool);
   if (urc != 0) {
     scd_error("cannot start %u workers: %s", cfg->workers, uv_strerror(urc));
-    uv_close((uv_handle_t *)&srv->listener, NULL);
-    srv->listener_open = 0;
+    scd_listen_close(srv);
     scd_pool_close(srv->pool);
     rc = 1;
     goto out_loop;
@@ -327,6 +332,8 @@ int scd_server_run(const scd_config_t *cfg) {
            srv->socket_path, cfg->socket_mode, cfg->workers,
            cfg->max_connections, cfg->max_jobs,
            (unsigned long long)srv->max_points, budget, cfg->grace);
+  for (unsigned i = 0; i < srv->ntcp; i++)
+    scd_info("listening on %s (clients must send the token)", srv->tcp[i].name);
 
 out_loop:
   uv_run(srv->loop, UV_RUN_DEFAULT);
@@ -341,6 +348,7 @@ out_loop:
 out:
   scd_listen_cleanup(srv);
   uv_loop_close(srv->loop);
+  scd_token_forget(srv);
   free(srv);
   return rc;
 }

@@ -17,6 +17,9 @@ int scp__check_hello(const scp_hello_t *m) {
     return SCP_EVERSION;
   if (m->max_frame < SCP_FRAME_MIN)
     return SCP_ERANGE;
+  if ((m->features & SCP_FEATURE_TOKEN) &&
+      (m->token_len > SCP_TOKEN_MAX || (m->token_len && !m->token)))
+    return SCP_ERANGE;
   return 0;
 }
 

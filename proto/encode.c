@@ -85,13 +85,20 @@ static int frame_begin(scp_buf_t *b, uint16_t type, uint64_t payload,
 int scp_enc_hello(scp_buf_t *b, const scp_hello_t *m) {
   int rc = scp__check_hello(m);
   uint8_t *p;
-  if (rc || (rc = frame_begin(b, SCP_HELLO, 24, &p)))
+  int token = (m->features & SCP_FEATURE_TOKEN) != 0;
+  uint64_t len = SCP_HELLO_FIXED + (token ? 4 + (uint64_t)m->token_len : 0);
+  if (rc || (rc = frame_begin(b, SCP_HELLO, len, &p)))
     return rc;
   memcpy(p, SCP_MAGIC, SCP_MAGIC_LEN);
   scp__st16(p + 4, m->version_min);
   scp__st16(p + 6, m->version_max);
   scp__st64(p + 8, m->features);
   scp__st32(p + 16, m->max_frame);
+  if (token) {
+    scp__st32(p + SCP_HELLO_FIXED, m->token_len);
+    if (m->token_len)
+      memcpy(p + SCP_HELLO_FIXED + 4, m->token, m->token_len);
+  }
   return 0;
 }
 

@@ -41,3 +41,20 @@ int scp_handshake_check(const scp_hello_t *sent, const scp_welcome_t *got) {
     return SCP_EFLAGS;
   return 0;
 }
+
+int scp_token_equal(const scp_hello_t *hello, const uint8_t *expected,
+                    size_t expected_len) {
+  if (!(hello->features & SCP_FEATURE_TOKEN) || !expected)
+    return 0;
+  const uint8_t *got = hello->token;
+  size_t got_len = hello->token_len;
+  /* Every byte of the expected token is looked at whatever came, and the
+   * differences are gathered without a branch on them; volatile keeps the
+   * compiler from stopping at the first one. */
+  volatile uint8_t diff = (uint8_t)(got_len != expected_len);
+  for (size_t i = 0; i < expected_len; i++) {
+    uint8_t g = i < got_len ? got[i] : 0;
+    diff |= (uint8_t)(g ^ expected[i]);
+  }
+  return diff == 0;
+}

@@ -62,13 +62,28 @@ static int handshake_start(const scp_frame_t *f, uint16_t type, uint32_t n) {
 
 int scp_parse_hello(const scp_frame_t *f, scp_hello_t *out) {
   const uint8_t *p = f->payload;
-  int rc = handshake_start(f, SCP_HELLO, 24);
+  int rc = handshake_start(f, SCP_HELLO, SCP_HELLO_FIXED);
   if (rc || (rc = zero32(p + 20)))
     return rc;
   out->version_min = scp__ld16(p + 4);
   out->version_max = scp__ld16(p + 6);
   out->features = scp__ld64(p + 8);
   out->max_frame = scp__ld32(p + 16);
+  out->token = NULL;
+  out->token_len = 0;
+  /* Without the TOKEN bit whatever follows the fixed part is a later
+   * version's tail, and ignored (PROTOCOL.md 3.3). */
+  if (out->features & SCP_FEATURE_TOKEN) {
+    if (f->length < SCP_HELLO_FIXED + 4)
+      return SCP_ESHORT;
+    uint32_t n = scp__ld32(p + SCP_HELLO_FIXED);
+    if (n > SCP_TOKEN_MAX)
+      return SCP_ERANGE;
+    if ((uint64_t)SCP_HELLO_FIXED + 4 + n > f->length)
+      return SCP_ELENGTH;
+    out->token_len = n;
+    out->token = n ? p + SCP_HELLO_FIXED + 4 : NULL;
+  }
   return scp__check_hello(out);
 }
 

@@ -134,7 +134,8 @@ int scp_err_is_fatal(int code);
   X(DEGENERATE_INPUT, 15,                                                      \
     "degenerate input: fewer than 4 distinct points, or all coplanar")         \
   X(NONFINITE, 16, "non-finite coordinate (NaN or Inf) in the input")          \
-  X(INTERNAL, 17, "internal error")
+  X(INTERNAL, 17, "internal error")                                            \
+  X(AUTH, 18, "authentication failed: wrong or missing token")
 
 typedef enum scp_wire_err {
 #define SCP_WIRE_ENUM_(name, value, msg) SCP_WIRE_##name = (value),
@@ -221,6 +222,34 @@ const char *scp_stage_name(uint32_t stage);
  * the path into buf (cut to len - 1 bytes) and returns buf. */
 char *scp_default_socket(char *buf, size_t len);
 
+/*
+ * Addresses, as the daemon's --listen and a client's --connect take them
+ * (PROTOCOL.md 2): "unix://PATH" or a plain PATH (no "://" in it) for a
+ * Unix socket, "tcp://HOST:PORT" for TCP, HOST a name, an IPv4 address or
+ * an IPv6 address in brackets ("tcp://[::1]:7341"). PORT is 0 to 65535; 0
+ * lets a listener choose one.
+ */
+typedef enum scp_addr_kind {
+  SCP_ADDR_UNIX = 1,
+  SCP_ADDR_TCP = 2
+} scp_addr_kind_t;
+/* sun_path of Linux: the longest path is one byte less. */
+#define SCP_ADDR_PATH_MAX 108
+#define SCP_ADDR_HOST_MAX 255
+typedef struct scp_address {
+  int kind;                         /* scp_addr_kind_t */
+  char path[SCP_ADDR_PATH_MAX];     /* SCP_ADDR_UNIX */
+  char host[SCP_ADDR_HOST_MAX + 1]; /* SCP_ADDR_TCP, without brackets */
+  uint16_t port;                    /* SCP_ADDR_TCP */
+} scp_address_t;
+/* 0 with *out filled; SCP_ERANGE for text that is not an address (an
+ * unknown scheme, an empty or too long path or host, a bad port), and
+ * SCP_EINVAL for NULL. */
+int scp_address_parse(const char *text, scp_address_t *out);
+/* The address as text ("unix://PATH", "tcp://HOST:PORT", brackets around an
+ * IPv6 host), cut to len - 1 bytes; returns buf. */
+char *scp_address_format(const scp_address_t *a, char *buf, size_t len);
+
 /* Element formats of chunk frames. */
 typedef enum scp_format {
   SCP_F32_XYZ = 1,
@@ -232,8 +261,16 @@ typedef enum scp_format {
 size_t scp_format_size(uint32_t format);
 
 /* Feature bits (PROTOCOL.md 5). JOB_OPTIONS: JOB_BEGIN may carry job
- * options after its fixed part. */
+ * options after its fixed part. TOKEN: HELLO carries the token field after
+ * its fixed part (a shared secret; a server that listens on TCP requires
+ * it there). */
 #define SCP_FEATURE_JOB_OPTIONS 0x1u
+#define SCP_FEATURE_TOKEN 0x2u
+/* Fixed part of HELLO, and where the token field starts with TOKEN. */
+#define SCP_HELLO_FIXED 24
+/* The longest token HELLO carries, in bytes: the handshake's frames stay
+ * within SCP_FRAME_MIN. */
+#define SCP_TOKEN_MAX 1024
 /* Job options (PROTOCOL.md 6.3) are named by the reconstruction's
  * parameter table (SC_PARAM_MAP in core/shortcrust.h), which this module
  * does not see: it carries them as a value list. */
@@ -259,6 +296,11 @@ typedef struct scp_hello {
   uint16_t version_max; /* >= version_min */
   uint64_t features;    /* any bits */
   uint32_t max_frame;   /* >= SCP_FRAME_MIN */
+  /* With SCP_FEATURE_TOKEN in features: the token, token_len bytes (at
+   * most SCP_TOKEN_MAX, 0 for none), any bytes. The parser points into the
+   * payload; the encoder sends them. Without the bit both are ignored. */
+  const uint8_t *token;
+  uint32_t token_len;
 } scp_hello_t;
 
 typedef struct scp_welcome {
@@ -692,6 +734,13 @@ int scp_frame_job_id(const scp_frame_t *f, uint32_t *job_id);
  */
 int scp_handshake_answer(const scp_hello_t *hello, const scp_welcome_t *server,
                          scp_welcome_t *out);
+/* 1 when the token HELLO carried (with SCP_FEATURE_TOKEN) is the
+ * expected one, byte for byte, else 0. The time it takes depends on the
+ * lengths only, never on where the bytes differ, so that a peer cannot
+ * guess a token byte by byte from how fast it is refused. */
+int scp_token_equal(const scp_hello_t *hello, const uint8_t *expected,
+                    size_t expected_len);
+
 /* Client: checks the server's WELCOME against the HELLO it sent. Any error
  * makes WELCOME malformed: fatal ERROR PROTOCOL, then close. */
 int scp_handshake_check(const scp_hello_t *sent, const scp_welcome_t *got);

@@ -8,6 +8,7 @@ packages=(
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev libeigen3-dev libtbb-dev
   libuv1-dev
   clang libclang-rt-dev
+  haproxy
 )
 
 missing=()

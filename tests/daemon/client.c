@@ -6,10 +6,12 @@
  */
 #include "client.h"
 
+#include <arpa/inet.h>
 #include <errno.h>
+#include <netinet/in.h>
 #include <poll.h>
-#include <stdatomic.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,15 +26,43 @@ uint64_t scdt_now_ms(void) {
   return (uint64_t)ts.tv_sec * 1000u + (uint64_t)ts.tv_nsec / 1000000u;
 }
 
+/* A TCP connection to an IPv4 literal and port: the fd, or -errno. */
+static int connect_tcp(const char *text) {
+  scp_address_t a;
+  struct sockaddr_in sin;
+  memset(&sin, 0, sizeof sin);
+  sin.sin_family = AF_INET;
+  if (scp_address_parse(text, &a) != 0 || a.kind != SCP_ADDR_TCP ||
+      inet_pton(AF_INET, a.host, &sin.sin_addr) != 1)
+    return -EINVAL;
+  sin.sin_port = htons(a.port);
+  int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0)
+    return -errno;
+  if (connect(fd, (struct sockaddr *)&sin, sizeof sin) != 0) {
+    int e = errno;
+    close(fd);
+    return -e;
+  }
+  return fd;
+}
+
 int scdt_connect(const char *path, scdt_conn_t **out) {
   *out = NULL;
+  int fd;
+  if (strncmp(path, "tcp://", 6) == 0) {
+    fd = connect_tcp(path);
+    if (fd < 0)
+      return fd;
+    goto connected;
+  }
   struct sockaddr_un sa;
   memset(&sa, 0, sizeof sa);
   sa.sun_family = AF_UNIX;
   if (strlen(path) >= sizeof sa.sun_path)
     return -ENAMETOOLONG;
   memcpy(sa.sun_path, path, strlen(path) + 1);
-  int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd < 0)
     return -errno;
   if (connect(fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
@@ -40,6 +70,7 @@ int scdt_connect(const char *path, scdt_conn_t **out) {
     close(fd);
     return -e;
   }
+connected:;
   scdt_conn_t *c = calloc(1, sizeof *c);
   scp_limits_t lim;
   scp_limits_init(&lim);
@@ -216,7 +247,9 @@ int scdt_handshake_v(scdt_conn_t *c, uint16_t vmin, uint16_t vmax,
   scp_hello_t h = {.version_min = vmin,
                    .version_max = vmax,
                    .features = c->features,
-                   .max_frame = max_frame};
+                   .max_frame = max_frame,
+                   .token = c->token,
+                   .token_len = c->token_len};
   if (scp_enc_hello(&c->out, &h) != 0)
     return -1;
   /* A server that refuses us may close before it reads the HELLO; its

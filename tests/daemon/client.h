@@ -33,14 +33,18 @@ typedef struct scdt_conn {
   scdt_frame_t *qhead, *qtail; /* frames read, not yet taken */
   int eof;                     /* the server closed (or reset) */
   int dec_err;                 /* the decoder's sticky error */
-  /* Feature bits the handshake offers (default none). */
+  /* Feature bits the handshake offers (default none), and with
+   * SCP_FEATURE_TOKEN among them the token HELLO carries. */
   uint64_t features;
+  const uint8_t *token;
+  uint32_t token_len;
   /* The last ERROR frame seen by scdt_collect(). */
   int got_error;
   scp_error_t last_error;
 } scdt_conn_t;
 
-/* Connects (no handshake). 0 or -errno. */
+/* Connects (no handshake) to a Unix socket at path, or to
+ * "tcp://IPV4:PORT". 0 or -errno. */
 int scdt_connect(const char *path, scdt_conn_t **out);
 /* HELLO with the given versions and frame limit, then waits for WELCOME:
  * 0, the wire code of the ERROR the server answered with (> 0), or -1. */

@@ -1,0 +1,203 @@
+/*
+ * TCP listeners and their token (PROTOCOL.md 5.1): a client with the token
+ * gets its mesh; no token, an empty one, a wrong one or a prefix of the
+ * right one get a fatal ERROR AUTH and nothing else, not even a PONG for a
+ * PING sent behind the HELLO; each refusal is counted in STATS and logged
+ * without the token; on the Unix socket a token is ignored, wrong or not.
+ * The daemon refuses to start with a TCP listener and no token file, and
+ * with a token file that group or others may read or that holds too short
+ * a token.
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <fcntl.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "daemontest.h"
+#include "synth.h"
+
+#define T_MS 120000
+#define TOKEN "f3a9c1d2e4b5a6978877665544332211"
+
+static double *sphere; /* 2000 points */
+
+static void write_file(const char *path, const char *text, mode_t mode) {
+  int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  ASSERT_MSG(fd >= 0, "cannot create %s", path);
+  ASSERT_EQ(write(fd, text, strlen(text)), (ssize_t)strlen(text));
+  close(fd);
+  ASSERT_EQ(chmod(path, mode), 0);
+}
+
+/* The address the daemon logged for its TCP listener (port 0 given). */
+static void tcp_address(const scdt_daemon_t *d, char *out, size_t len) {
+  ASSERT_MSG(scdt_log_wait(d, "listening on tcp://", T_MS),
+             "no TCP listener in the log");
+  FILE *f = fopen(d->log, "r");
+  ASSERT_NOT_NULL(f);
+  char line[512];
+  out[0] = '\0';
+  while (fgets(line, sizeof line, f)) {
+    char *p = strstr(line, "listening on tcp://");
+    if (p && sscanf(p, "listening on %63s", out) == 1)
+      break;
+  }
+  fclose(f);
+  ASSERT_MSG(strncmp(out, "tcp://127.0.0.1:", 16) == 0, "address '%s'", out);
+}
+
+/* A handshake with the given token (NULL: the TOKEN bit not offered):
+ * 0, the wire code of the ERROR, or -1. */
+static int hello_with(const char *addr, const char *token, size_t len,
+                      scdt_conn_t **out) {
+  scdt_conn_t *c;
+  int rc = scdt_connect(addr, &c);
+  EXPECT_MSG(rc == 0, "cannot connect to %s: %d", addr, rc);
+  if (rc != 0)
+    return -1;
+  c->features = SCP_FEATURE_JOB_OPTIONS;
+  if (token) {
+    c->features |= SCP_FEATURE_TOKEN;
+    c->token = (const uint8_t *)token;
+    c->token_len = (uint32_t)len;
+  }
+  rc = scdt_handshake(c, 1u << 20);
+  *out = c;
+  return rc;
+}
+
+/* A refused handshake: ERROR AUTH, fatal, naming HELLO, then the close. */
+static void expect_refused(const char *addr, const char *token, size_t len,
+                           const char *what) {
+  scdt_conn_t *c;
+  int rc = hello_with(addr, token, len, &c);
+  EXPECT_MSG(rc == SCP_WIRE_AUTH, "%s: handshake gave %d, want AUTH", what, rc);
+  if (rc == SCP_WIRE_AUTH) {
+    EXPECT_EQ(c->last_error.flags, SCP_ERROR_FATAL);
+    EXPECT_EQ(c->last_error.ref_type, SCP_HELLO);
+    EXPECT_MSG(strstr(c->last_error.message, TOKEN) == NULL,
+               "%s: the message holds the token", what);
+  }
+  EXPECT_MSG(scdt_wait_closed(c, T_MS), "%s: not closed", what);
+  scdt_close(c);
+}
+
+static void tcp_and_unix(void) {
+  scdt_daemon_t d;
+  ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
+  char token_file[200], addr[64];
+  snprintf(token_file, sizeof token_file, "%s/token", d.dir);
+  write_file(token_file, TOKEN "\n", 0600);
+  const char *args[] = {"--listen", "tcp://127.0.0.1:0", "--token-file",
+                        token_file, NULL};
+  ASSERT_MSG(scdt_daemon_spawn(&d, args, 1) == 0, "daemon did not start");
+  tcp_address(&d, addr, sizeof addr);
+
+  /* The right token: WELCOME says the field was read, and a job runs. */
+  scdt_conn_t *c;
+  ASSERT_EQ(hello_with(addr, TOKEN, strlen(TOKEN), &c), 0);
+  EXPECT_EQ(c->welcome.features & SCP_FEATURE_TOKEN, SCP_FEATURE_TOKEN);
+  scdt_run_ok(c, 1, SCS_SURF_SPHERE, sphere, 2000, T_MS, "TCP with token");
+  scdt_close(c);
+
+  /* Refused, one way after another. */
+  char wrong[] = TOKEN;
+  wrong[7] ^= 1;
+  expect_refused(addr, NULL, 0, "no TOKEN bit");
+  expect_refused(addr, "", 0, "an empty token");
+  expect_refused(addr, wrong, strlen(wrong), "a wrong token");
+  expect_refused(addr, TOKEN, strlen(TOKEN) - 1, "a prefix of the token");
+  expect_refused(addr, TOKEN "x", strlen(TOKEN) + 1, "a longer token");
+
+  /* Nothing behind a refused HELLO is carried out: a PING and a
+   * STATS_REQUEST in the same write get no answer. */
+  ASSERT_EQ(scdt_connect(addr, &c), 0);
+  scp_hello_t h = {.version_min = 1, .version_max = 1, .max_frame = 4096};
+  ASSERT_EQ(scp_enc_hello(&c->out, &h), 0);
+  ASSERT_EQ(scp_enc_ping(&c->out, 42), 0);
+  ASSERT_EQ(scp_enc_stats_request(&c->out, 7), 0);
+  scdt_flush(c, T_MS);
+  int errors = 0, others = 0;
+  scdt_frame_t *f;
+  while ((f = scdt_recv(c, T_MS)) != NULL) {
+    if (f->type == SCP_ERROR)
+      errors++;
+    else
+      others++;
+    free(f);
+  }
+  EXPECT_EQ(errors, 1);
+  EXPECT_MSG(others == 0, "%d frames answered a refused connection", others);
+  EXPECT(c->eof);
+  scdt_close(c);
+
+  /* The Unix socket needs no token, and ignores a wrong one. */
+  ASSERT_EQ(hello_with(d.sock, NULL, 0, &c), 0);
+  scdt_run_ok(c, 1, SCS_SURF_SPHERE, sphere, 2000, T_MS, "Unix, no token");
+  scdt_close(c);
+  ASSERT_EQ(hello_with(d.sock, wrong, strlen(wrong), &c), 0);
+  scdt_run_ok(c, 1, SCS_SURF_SPHERE, sphere, 2000, T_MS, "Unix, a wrong token");
+  scdt_close(c);
+
+  /* Six refusals counted apart from protocol errors; logged, and never
+   * with the token. */
+  uint64_t v = scdt_stat_fresh(d.sock, "auth_refused_total");
+  EXPECT_MSG(v == 6, "auth_refused_total %llu, want 6", (unsigned long long)v);
+  v = scdt_stat_fresh(d.sock, "protocol_errors_total");
+  EXPECT_MSG(v == 0, "protocol_errors_total %llu", (unsigned long long)v);
+  EXPECT_EQ(scdt_log_count(&d, "refused 127.0.0.1:"), 6);
+  EXPECT_MSG(!scdt_log_contains(&d, TOKEN) && !scdt_log_contains(&d, wrong),
+             "the log holds a token");
+  EXPECT_EQ(scdt_daemon_stop(&d), 0);
+}
+
+/* Start-up: a TCP listener needs a token file, and the file must be the
+ * daemon's alone and hold a token long enough. */
+static void refuses_to_start(void) {
+  scdt_daemon_t d;
+  ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
+  char token_file[200];
+  snprintf(token_file, sizeof token_file, "%s/token", d.dir);
+
+  const char *no_token[] = {"--listen", "tcp://127.0.0.1:0", NULL};
+  ASSERT_EQ(scdt_daemon_spawn(&d, no_token, 0), 0);
+  EXPECT_EQ(scdt_daemon_wait(&d, T_MS), 2);
+
+  const char *args[] = {"--listen", "tcp://127.0.0.1:0", "--token-file",
+                        token_file, NULL};
+  write_file(token_file, TOKEN "\n", 0640);
+  ASSERT_EQ(scdt_daemon_spawn(&d, args, 0), 0);
+  EXPECT_EQ(scdt_daemon_wait(&d, T_MS), 1);
+  EXPECT_MSG(scdt_log_contains(&d, "open to group or others (mode 0640)"),
+             "no clear message for a readable token file");
+  EXPECT_MSG(!scdt_log_contains(&d, TOKEN), "the log holds the token");
+
+  write_file(token_file, "short\n", 0600);
+  ASSERT_EQ(scdt_daemon_spawn(&d, args, 0), 0);
+  EXPECT_EQ(scdt_daemon_wait(&d, T_MS), 1);
+  EXPECT_MSG(scdt_log_contains(&d, "must have 16 to 1024 bytes"),
+             "no clear message for a short token");
+
+  unlink(token_file);
+  ASSERT_EQ(scdt_daemon_spawn(&d, args, 0), 0);
+  EXPECT_EQ(scdt_daemon_wait(&d, T_MS), 1);
+  EXPECT_MSG(scdt_log_contains(&d, "cannot open the token file"),
+             "no clear message for a missing token file");
+
+  const char *bad_listen[] = {"--listen", "udp://127.0.0.1:1", NULL};
+  ASSERT_EQ(scdt_daemon_spawn(&d, bad_listen, 0), 0);
+  EXPECT_EQ(scdt_daemon_wait(&d, T_MS), 2);
+}
+
+int main(int argc, char **argv) {
+  scdt_init(argc, argv);
+  sphere = scdt_sample(SCS_SURF_SPHERE, 2000, 1);
+  tcp_and_unix();
+  refuses_to_start();
+  free(sphere);
+  return scdt_finish();
+}
