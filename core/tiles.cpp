@@ -220,7 +220,9 @@ struct Tile {
   std::vector<uint32_t> own; // input indices, ascending
   DtSeq dt;
   std::vector<std::pair<uint32_t, uint32_t>> dups; // (duplicate, first)
-  std::vector<uint8_t> member; // by vertex number: foreign and inserted
+  // By vertex number: a foreign vertex inserted (a bit each: with many
+  // tiles of many points, a byte each would add up).
+  std::vector<bool> member;
   std::vector<Ch> infinite;
   std::vector<uint32_t> tris;
   sc_diag_t diag;
@@ -479,7 +481,7 @@ std::vector<Vh> insert_foreign(const Shared &s, Tile &t,
     const double *p = s.pts + 3 * size_t(v);
     Vh h = t.dt.insert(Point(p[0], p[1], p[2]), hint);
     h->info() = VertexData(v);
-    t.member[v] = 1;
+    t.member[v] = true;
     hint = h->cell();
     made.push_back(h);
   }
@@ -711,7 +713,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
     for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
          ++v)
       v->info() = VertexData(rank[v->info().idx]);
-    t.member.assign(m, 0);
+    t.member.assign(m, false);
     std::vector<uint32_t> add;
     for (size_t v = 0; v < m; ++v)
       if (owner[v] != t.id && in_box(t.reach, &pts[3 * v]))
