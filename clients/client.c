@@ -40,17 +40,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
-#include <sys/stat.h>
 #include <sys/un.h>
 #include <time.h>
 #include <unistd.h>
 
 #define SCC_READ_SIZE (64 * 1024)
-
-/* memset through a volatile pointer: a wipe of memory that is about to be
- * freed or to go out of scope is otherwise a dead store the compiler may
- * drop. */
-static void *(*const volatile wipe)(void *, int, size_t) = memset;
 
 static const struct {
   int code;
@@ -506,57 +500,13 @@ static int connect_tcp(sc_client_t *c, int timeout_ms, char *msg,
   return e == ETIMEDOUT ? SC_CLIENT_ETIMEOUT : SC_CLIENT_ECONNECT;
 }
 
-/* The token file: the daemon's rules (one line; open to its owner only),
- * so that a file the daemon would refuse is not used here either. */
+/* The token file, by the daemon's rules (scp_token_read()), so that a
+ * file the daemon would refuse is not used here either. */
 static int read_token_file(sc_client_t *c, const char *path, char *msg,
                            size_t msg_len) {
-  int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) {
-    set_msg(msg, msg_len, "cannot open the token file %s: %s", path,
-            strerror(errno));
+  if (scp_token_read(path, 1, c->token, &c->token_len, msg, msg_len) != 0)
     return SC_CLIENT_EAUTH;
-  }
-  struct stat st;
-  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || (st.st_mode & 077)) {
-    set_msg(msg, msg_len,
-            "the token file %s must be a regular file open to its owner "
-            "only (chmod 600 %s)",
-            path, path);
-    close(fd);
-    return SC_CLIENT_EAUTH;
-  }
-  uint8_t buf[SCP_TOKEN_MAX + 3];
-  size_t len = 0;
-  for (;;) {
-    ssize_t n = read(fd, buf + len, sizeof buf - len);
-    if (n < 0 && errno == EINTR)
-      continue;
-    if (n < 0) {
-      set_msg(msg, msg_len, "cannot read the token file %s: %s", path,
-              strerror(errno));
-      close(fd);
-      return SC_CLIENT_EAUTH;
-    }
-    if (n == 0 || (len += (size_t)n) == sizeof buf)
-      break;
-  }
-  close(fd);
-  if (len && buf[len - 1] == '\n')
-    len--;
-  if (len && buf[len - 1] == '\r')
-    len--;
-  if (len == 0 || len > SCP_TOKEN_MAX) {
-    set_msg(msg, msg_len,
-            "the token file %s must hold one line of 1 to %d "
-            "bytes",
-            path, SCP_TOKEN_MAX);
-    wipe(buf, 0, sizeof buf);
-    return SC_CLIENT_EAUTH;
-  }
-  memcpy(c->token, buf, len);
-  c->token_len = len;
   c->has_token = 1;
-  wipe(buf, 0, sizeof buf);
   return 0;
 }
 
@@ -646,7 +596,7 @@ static int open_connection(sc_client_t *c, char *msg, size_t msg_len) {
              "; give the daemon's token (a token file, or SHORTCRUST_TOKEN)");
   /* Wipe the HELLO that held the token. */
   if (c->out.data)
-    wipe(c->out.data, 0, c->out.cap);
+    scp_wipe(c->out.data, c->out.cap);
   c->out.len = 0;
   c->out_at = 0;
   if (c->err) {
@@ -791,7 +741,7 @@ void sc_client_free(sc_client_t *c) {
   scp_buf_free(&c->out);
   free(c->rbuf);
   free(c->stats);
-  wipe(c->token, 0, sizeof c->token);
+  scp_wipe(c->token, sizeof c->token);
   free(c);
 }
 

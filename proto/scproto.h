@@ -740,6 +740,17 @@ int scp_handshake_answer(const scp_hello_t *hello, const scp_welcome_t *server,
  * guess a token byte by byte from how fast it is refused. */
 int scp_token_equal(const scp_hello_t *hello, const uint8_t *expected,
                     size_t expected_len);
+/* Reads the token file at path: a regular file open to its owner only,
+ * holding one line of min_len (at least 1) to SCP_TOKEN_MAX bytes, its
+ * line end not part of the token. Returns 0 with the token in token
+ * (SCP_TOKEN_MAX bytes of room) and its length in *len; -1 with a
+ * one-line message in msg that never holds the token. The only I/O of
+ * this module: the daemon and the clients read the file by one rule. */
+int scp_token_read(const char *path, size_t min_len, uint8_t *token,
+                   size_t *len, char *msg, size_t msg_len);
+/* Zeroes n bytes at p, also where the memory is about to be freed or go out
+ * of scope (a plain memset there is a dead store the compiler may drop). */
+void scp_wipe(void *p, size_t n);
 
 /* Client: checks the server's WELCOME against the HELLO it sent. Any error
  * makes WELCOME malformed: fatal ERROR PROTOCOL, then close. */
