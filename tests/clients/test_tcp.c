@@ -12,12 +12,10 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include "common.h"
@@ -27,27 +25,10 @@
 static scdt_daemon_t d;
 static char addr[64], token_file[200], port_arg[64];
 
-static void write_file(const char *path, const char *text, mode_t mode) {
-  int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  ASSERT_MSG(fd >= 0, "cannot create %s", path);
-  ASSERT_EQ(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  ASSERT_EQ(chmod(path, mode), 0);
-}
-
 /* The port the daemon chose, from its log. */
 static void read_address(void) {
-  ASSERT_MSG(scdt_log_wait(&d, "listening on tcp://", 30000),
+  ASSERT_MSG(scdt_log_tcp_address(&d, 30000, addr, sizeof addr),
              "no TCP listener in the log");
-  FILE *f = fopen(d.log, "r");
-  ASSERT_NOT_NULL(f);
-  char line[512];
-  while (fgets(line, sizeof line, f)) {
-    char *p = strstr(line, "listening on tcp://");
-    if (p && sscanf(p, "listening on %63s", addr) == 1)
-      break;
-  }
-  fclose(f);
   ASSERT_MSG(strncmp(addr, "tcp://127.0.0.1:", 16) == 0, "address '%s'", addr);
 }
 
@@ -123,7 +104,7 @@ static void addresses_and_tokens(void) {
    * goes out. */
   char loose[220];
   snprintf(loose, sizeof loose, "%s/loose-token", d.dir);
-  write_file(loose, TOKEN "\n", 0644);
+  ASSERT_EQ(scdt_write_file(loose, TOKEN "\n", 0644), 0);
   EXPECT_EQ(try_connect(addr, NULL, loose, msg, sizeof msg, &c),
             SC_CLIENT_EAUTH);
   EXPECT_STR_CONTAINS(msg, "chmod 600");
@@ -255,7 +236,7 @@ int main(int argc, char **argv) {
   unsetenv("SHORTCRUST_TOKEN");
   ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
   snprintf(token_file, sizeof token_file, "%s/token", d.dir);
-  write_file(token_file, TOKEN "\n", 0600);
+  ASSERT_EQ(scdt_write_file(token_file, TOKEN "\n", 0600), 0);
   start();
   addresses_and_tokens();
   retries();

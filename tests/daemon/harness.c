@@ -255,6 +255,35 @@ int scdt_log_count(const scdt_daemon_t *d, const char *text) {
   return log_scan(d, text, 1);
 }
 
+int scdt_log_tcp_address(const scdt_daemon_t *d, int timeout_ms, char *out,
+                         size_t len) {
+  out[0] = '\0';
+  if (!scdt_log_wait(d, "listening on tcp://", timeout_ms))
+    return 0;
+  FILE *f = fopen(d->log, "r");
+  if (!f)
+    return 0;
+  char line[512], fmt[32];
+  snprintf(fmt, sizeof fmt, "listening on %%%zus", len - 1);
+  while (fgets(line, sizeof line, f)) {
+    const char *p = strstr(line, "listening on tcp://");
+    if (p && sscanf(p, fmt, out) == 1)
+      break;
+  }
+  fclose(f);
+  return out[0] != '\0';
+}
+
+int scdt_write_file(const char *path, const char *text, mode_t mode) {
+  int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  if (fd < 0)
+    return -1;
+  const size_t n = strlen(text);
+  const int ok = write(fd, text, n) == (ssize_t)n;
+  close(fd);
+  return ok && chmod(path, mode) == 0 ? 0 : -1;
+}
+
 static double *sample(int surface, int density, size_t n, uint64_t seed) {
   double *xyz = malloc(n * 3 * sizeof(double));
   if (!xyz)

@@ -59,6 +59,13 @@ int scdt_log_contains(const scdt_daemon_t *d, const char *text);
 int scdt_log_wait(const scdt_daemon_t *d, const char *text, int timeout_ms);
 /* Counts lines of the log containing the text. */
 int scdt_log_count(const scdt_daemon_t *d, const char *text);
+/* Waits up to timeout_ms for the log to name the daemon's TCP listener
+ * ("listening on tcp://...", where port 0 was given) and copies that
+ * address into out: 1 when it did, else 0 (out then empty). */
+int scdt_log_tcp_address(const scdt_daemon_t *d, int timeout_ms, char *out,
+                         size_t len);
+/* Writes text to path, then gives it the mode: 0, or -1. */
+int scdt_write_file(const char *path, const char *text, mode_t mode);
 
 /* Well-spaced samples of a test surface (scs_surface_t), malloc'd. */
 double *scdt_sample(int surface, size_t n, uint64_t seed);

@@ -11,10 +11,8 @@
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
-#include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include "daemontest.h"
@@ -25,28 +23,10 @@
 
 static double *sphere; /* 2000 points */
 
-static void write_file(const char *path, const char *text, mode_t mode) {
-  int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  ASSERT_MSG(fd >= 0, "cannot create %s", path);
-  ASSERT_EQ(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  ASSERT_EQ(chmod(path, mode), 0);
-}
-
 /* The address the daemon logged for its TCP listener (port 0 given). */
-static void tcp_address(const scdt_daemon_t *d, char *out, size_t len) {
-  ASSERT_MSG(scdt_log_wait(d, "listening on tcp://", T_MS),
+static void tcp_address(const scdt_daemon_t *dm, char *out, size_t len) {
+  ASSERT_MSG(scdt_log_tcp_address(dm, T_MS, out, len),
              "no TCP listener in the log");
-  FILE *f = fopen(d->log, "r");
-  ASSERT_NOT_NULL(f);
-  char line[512];
-  out[0] = '\0';
-  while (fgets(line, sizeof line, f)) {
-    char *p = strstr(line, "listening on tcp://");
-    if (p && sscanf(p, "listening on %63s", out) == 1)
-      break;
-  }
-  fclose(f);
   ASSERT_MSG(strncmp(out, "tcp://127.0.0.1:", 16) == 0, "address '%s'", out);
 }
 
@@ -91,7 +71,7 @@ static void tcp_and_unix(void) {
   ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
   char token_file[200], addr[64];
   snprintf(token_file, sizeof token_file, "%s/token", d.dir);
-  write_file(token_file, TOKEN "\n", 0600);
+  ASSERT_EQ(scdt_write_file(token_file, TOKEN "\n", 0600), 0);
   const char *args[] = {"--listen", "tcp://127.0.0.1:0", "--token-file",
                         token_file, NULL};
   ASSERT_MSG(scdt_daemon_spawn(&d, args, 1) == 0, "daemon did not start");
@@ -169,14 +149,14 @@ static void refuses_to_start(void) {
 
   const char *args[] = {"--listen", "tcp://127.0.0.1:0", "--token-file",
                         token_file, NULL};
-  write_file(token_file, TOKEN "\n", 0640);
+  ASSERT_EQ(scdt_write_file(token_file, TOKEN "\n", 0640), 0);
   ASSERT_EQ(scdt_daemon_spawn(&d, args, 0), 0);
   EXPECT_EQ(scdt_daemon_wait(&d, T_MS), 1);
   EXPECT_MSG(scdt_log_contains(&d, "open to group or others (mode 0640)"),
              "no clear message for a readable token file");
   EXPECT_MSG(!scdt_log_contains(&d, TOKEN), "the log holds the token");
 
-  write_file(token_file, "short\n", 0600);
+  ASSERT_EQ(scdt_write_file(token_file, "short\n", 0600), 0);
   ASSERT_EQ(scdt_daemon_spawn(&d, args, 0), 0);
   EXPECT_EQ(scdt_daemon_wait(&d, T_MS), 1);
   EXPECT_MSG(scdt_log_contains(&d, "must have 16 to 1024 bytes"),
