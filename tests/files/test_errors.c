@@ -11,36 +11,6 @@
 #include "shortcrust_files.h"
 #include "plybuf.h"
 
-/* Reads path as points (mesh 0) or as a mesh and expects code rc with a
- * message that starts with the path and contains both fragments. */
-static void expect_fail(const char *path, int mesh, int rc, const char *frag1,
-                        const char *frag2) {
-  char msg[512];
-  scf_points_t p;
-  uint32_t *tri = (uint32_t *)msg;
-  size_t nt = 5;
-  memset(msg, 'x', sizeof msg);
-  int got = mesh ? scf_mesh_read(path, &p, &tri, &nt, msg, sizeof msg)
-                 : scf_points_read(path, &p, msg, sizeof msg);
-  if (got != rc)
-    ASSERT_FAIL("reading %s: %s (%s), expected %s", path, scf_err_name(got),
-                got ? msg : "", scf_err_name(rc));
-  ASSERT(p.xyz == NULL);
-  ASSERT_EQ(p.count, 0);
-  if (mesh) {
-    ASSERT(tri == NULL);
-    ASSERT_EQ(nt, 0);
-  }
-  ASSERT(memchr(msg, '\0', sizeof msg) != NULL);
-  ASSERT(strchr(msg, '\n') == NULL);
-  if (strncmp(msg, path, strlen(path)) != 0 || msg[strlen(path)] != ':')
-    ASSERT_FAIL("\"%s\" does not start with \"%s:\"", msg, path);
-  if (frag1 != NULL)
-    ASSERT_STR_CONTAINS(msg, frag1);
-  if (frag2 != NULL)
-    ASSERT_STR_CONTAINS(msg, frag2);
-}
-
 typedef struct bad_case {
   const char *name; /* the extension chooses the reader */
   const char *text;
@@ -120,8 +90,8 @@ static void run_cases(const bad_case_t *cases, size_t n) {
   for (size_t i = 0; i < n; i++) {
     const char *path = tmp_path(cases[i].name);
     write_text(path, cases[i].text);
-    expect_fail(path, cases[i].mesh, cases[i].rc, cases[i].frag1,
-                cases[i].frag2);
+    expect_read_fail(path, cases[i].mesh, cases[i].rc, cases[i].frag1,
+                     cases[i].frag2);
   }
 }
 
@@ -154,8 +124,8 @@ static void test_counts_beyond_file(void) {
   buf_write(&b, path);
   char want[128];
   snprintf(want, sizeof want, "byte %zu: ", header + 36);
-  expect_fail(path, 0, SCF_EFORMAT, want,
-              "file ends before vertex 3 of 1152921504606846976");
+  expect_read_fail(path, 0, SCF_EFORMAT, want,
+                   "file ends before vertex 3 of 1152921504606846976");
   buf_free(&b);
 
   /* A count whose size overflows 64 bits. */
@@ -169,9 +139,10 @@ static void test_counts_beyond_file(void) {
   path = tmp_path("overflow.ply");
   buf_write(&b, path);
   snprintf(want, sizeof want, "byte %zu: ", header);
-  expect_fail(path, 0, SCF_EFORMAT, want,
-              "file ends inside vertex 0 of 9223372036854775807 (expected 24 "
-              "bytes, got 8)");
+  expect_read_fail(
+      path, 0, SCF_EFORMAT, want,
+      "file ends inside vertex 0 of 9223372036854775807 (expected 24 "
+      "bytes, got 8)");
   buf_free(&b);
 
   /* An element before the vertices, with lists so that its size is only a
@@ -185,8 +156,8 @@ static void test_counts_beyond_file(void) {
   path = tmp_path("junk.ply");
   buf_write(&b, path);
   snprintf(want, sizeof want, "byte %zu: ", header);
-  expect_fail(path, 0, SCF_EFORMAT, want,
-              "declares 1000000000000 junk records");
+  expect_read_fail(path, 0, SCF_EFORMAT, want,
+                   "declares 1000000000000 junk records");
   buf_free(&b);
 
   /* Faces: only a mesh read needs them. */
@@ -203,7 +174,7 @@ static void test_counts_beyond_file(void) {
   path = tmp_path("faces.ply");
   buf_write(&b, path);
   snprintf(want, sizeof want, "byte %zu: ", header);
-  expect_fail(path, 1, SCF_EFORMAT, want, "4000000000 face records");
+  expect_read_fail(path, 1, SCF_EFORMAT, want, "4000000000 face records");
   buf_free(&b);
   scf_points_t p;
   char msg[256];
@@ -250,12 +221,12 @@ static void test_counts_beyond_file(void) {
   stl[82] = 0x0f;
   path = tmp_path("huge.stl");
   write_bytes(path, stl, sizeof stl);
-  expect_fail(path, 1, SCF_EFORMAT,
-              "byte 80: ", "declares 1000000 triangles");
+  expect_read_fail(path, 1, SCF_EFORMAT,
+                   "byte 80: ", "declares 1000000 triangles");
   path = tmp_path("tiny.stl");
   write_bytes(path, stl, 40);
-  expect_fail(path, 1, SCF_EFORMAT,
-              "byte 40: ", "inside the 84-byte binary STL header");
+  expect_read_fail(path, 1, SCF_EFORMAT,
+                   "byte 40: ", "inside the 84-byte binary STL header");
 }
 
 /*
@@ -296,8 +267,8 @@ static void check_cut(const char *path, int mesh, const layout_t *l,
     /* Only the line end after end_header is missing: the header is whole
      * and the data, all of it missing, begins where the file ends. */
     snprintf(want1, sizeof want1, "byte %zu: ", cut);
-    expect_fail(path, mesh, SCF_EFORMAT, want1,
-                generic ? generic : "file ends before vertex 0 of 5");
+    expect_read_fail(path, mesh, SCF_EFORMAT, want1,
+                     generic ? generic : "file ends before vertex 0 of 5");
     return;
   }
   if (cut < header) {
@@ -316,7 +287,7 @@ static void check_cut(const char *path, int mesh, const layout_t *l,
   }
   if (generic != NULL) {
     snprintf(want1, sizeof want1, "byte %zu: ", header);
-    expect_fail(path, mesh, SCF_EFORMAT, want1, generic);
+    expect_read_fail(path, mesh, SCF_EFORMAT, want1, generic);
     return;
   }
   const piece_t *pc = NULL;
@@ -334,7 +305,7 @@ static void check_cut(const char *path, int mesh, const layout_t *l,
              "file ends inside %s %d of %s (expected %zu bytes, got %zu)",
              pc->elem, pc->rec, strcmp(pc->elem, "vertex") ? "4" : "5",
              pc->size, got);
-  expect_fail(path, mesh, SCF_EFORMAT, want1, want2);
+  expect_read_fail(path, mesh, SCF_EFORMAT, want1, want2);
 }
 
 static void test_every_cut(void) {
@@ -532,7 +503,7 @@ static void test_bad_text(void) {
   /* A NUL inside a line, as in a binary file given a text extension. */
   const char *path = tmp_path("nul.xyz");
   write_bytes(path, "1 2 3\n4 5\0 6\n", 13);
-  expect_fail(path, 0, SCF_EFORMAT, "line 2: ", "NUL byte");
+  expect_read_fail(path, 0, SCF_EFORMAT, "line 2: ", "NUL byte");
 
   /* A binary face list: the offending index is named by its offset. */
   buf_t b = {0};
@@ -553,13 +524,13 @@ static void test_bad_text(void) {
   buf_write(&b, path);
   char want[64];
   snprintf(want, sizeof want, "byte %zu: ", face1 + 5);
-  expect_fail(path, 1, SCF_EFORMAT, want,
-              "face 1 refers to vertex 4000000000, but there are 3");
+  expect_read_fail(path, 1, SCF_EFORMAT, want,
+                   "face 1 refers to vertex 4000000000, but there are 3");
   /* A negative list length. */
   b.p[face1] = 0xff;
   buf_write(&b, path);
   snprintf(want, sizeof want, "byte %zu: ", face1);
-  expect_fail(path, 1, SCF_EFORMAT, want, "negative list length -1");
+  expect_read_fail(path, 1, SCF_EFORMAT, want, "negative list length -1");
   buf_free(&b);
 
   /* A line longer than the reader takes (64 KiB). */
@@ -572,33 +543,34 @@ static void test_bad_text(void) {
   memcpy(text + 6 + n, "4 5 6\n", 6);
   write_bytes(path, text, n + 12);
   free(text);
-  expect_fail(path, 0, SCF_EFORMAT, "line 2: ", "line longer than");
+  expect_read_fail(path, 0, SCF_EFORMAT, "line 2: ", "line longer than");
 }
 
 /* Files that cannot be read at all, and extensions that are not known. */
 static void test_unreadable(void) {
-  expect_fail(tmp_path("missing.ply"), 0, SCF_ENOENT, "cannot open", NULL);
-  expect_fail(tmp_path("missing.obj"), 1, SCF_ENOENT, "cannot open", NULL);
+  expect_read_fail(tmp_path("missing.ply"), 0, SCF_ENOENT, "cannot open", NULL);
+  expect_read_fail(tmp_path("missing.obj"), 1, SCF_ENOENT, "cannot open", NULL);
   const char *dir = tmp_path("dir.xyz");
   ASSERT(mkdir(dir, 0700) == 0);
-  expect_fail(dir, 0, SCF_EIO, "is a directory", NULL);
+  expect_read_fail(dir, 0, SCF_EIO, "is a directory", NULL);
 
   /* The extension is judged before the file is looked at. */
-  expect_fail(tmp_path("points.e57"), 0, SCF_EUNSUPPORTED,
-              "unknown extension '.e57'", "expected .ply, .xyz");
-  expect_fail(tmp_path("points"), 0, SCF_EUNSUPPORTED, "no file extension",
-              NULL);
-  expect_fail(tmp_path("dir.ply/points"), 0, SCF_EUNSUPPORTED,
-              "no file extension", NULL);
-  expect_fail(tmp_path(".ply"), 0, SCF_EUNSUPPORTED, "no file extension",
-              NULL);
-  expect_fail(tmp_path("points.plyy"), 0, SCF_EUNSUPPORTED,
-              "unknown extension '.plyy'", NULL);
+  expect_read_fail(tmp_path("points.e57"), 0, SCF_EUNSUPPORTED,
+                   "unknown extension '.e57'", "expected .ply, .xyz");
+  expect_read_fail(tmp_path("points"), 0, SCF_EUNSUPPORTED, "no file extension",
+                   NULL);
+  expect_read_fail(tmp_path("dir.ply/points"), 0, SCF_EUNSUPPORTED,
+                   "no file extension", NULL);
+  expect_read_fail(tmp_path(".ply"), 0, SCF_EUNSUPPORTED, "no file extension",
+                   NULL);
+  expect_read_fail(tmp_path("points.plyy"), 0, SCF_EUNSUPPORTED,
+                   "unknown extension '.plyy'", NULL);
   /* Point-only formats are no meshes, and STL has no point-only use. */
-  expect_fail(tmp_path("mesh.xyz"), 1, SCF_EUNSUPPORTED,
-              "unknown extension '.xyz'", "expected .ply, .off, .obj or .stl");
-  expect_fail(tmp_path("mesh.stl"), 0, SCF_EUNSUPPORTED,
-              "unknown extension '.stl'", NULL);
+  expect_read_fail(tmp_path("mesh.xyz"), 1, SCF_EUNSUPPORTED,
+                   "unknown extension '.xyz'",
+                   "expected .ply, .off, .obj or .stl");
+  expect_read_fail(tmp_path("mesh.stl"), 0, SCF_EUNSUPPORTED,
+                   "unknown extension '.stl'", NULL);
 }
 
 /* An index not below the point count: refused before anything is created,

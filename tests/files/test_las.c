@@ -50,23 +50,7 @@ static void check_points(const char *path, const las_spec_t *s) {
  * that starts with the path and contains both fragments. */
 static void expect_fail(const char *path, int rc, const char *frag1,
                         const char *frag2) {
-  char msg[512];
-  scf_points_t p;
-  memset(msg, 'x', sizeof msg);
-  int got = scf_points_read(path, &p, msg, sizeof msg);
-  if (got != rc)
-    ASSERT_FAIL("reading %s: %s (%s), expected %s", path, scf_err_name(got),
-                got ? msg : "", scf_err_name(rc));
-  ASSERT(p.xyz == NULL);
-  ASSERT_EQ(p.count, 0);
-  ASSERT(memchr(msg, '\0', sizeof msg) != NULL);
-  ASSERT(strchr(msg, '\n') == NULL);
-  if (strncmp(msg, path, strlen(path)) != 0 || msg[strlen(path)] != ':')
-    ASSERT_FAIL("\"%s\" does not start with \"%s:\"", msg, path);
-  if (frag1 != NULL)
-    ASSERT_STR_CONTAINS(msg, frag1);
-  if (frag2 != NULL)
-    ASSERT_STR_CONTAINS(msg, frag2);
+  expect_read_fail(path, 0, rc, frag1, frag2);
 }
 
 /* n points of coordinates that reach the limits of int32 and its sign,

@@ -1,6 +1,7 @@
 /*
- * A private temporary directory and small file helpers for the file-format
- * tests. Failures go through sct_assert.h, like every test's.
+ * A private temporary directory, small file helpers and the check of a
+ * failed read for the file-format tests. Failures go through sct_assert.h, like
+ * every test's.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -19,6 +20,7 @@
 #include <unistd.h>
 
 #include "sct_assert.h"
+#include "shortcrust_files.h"
 
 static char tmp_dir_[256];
 
@@ -120,6 +122,36 @@ static inline int count_entries(const char *dir, const char *needle) {
   if (d != NULL)
     closedir(d);
   return n;
+}
+
+/* Reads path as points (mesh 0) or as a mesh and expects code rc with a
+ * message that starts with the path and contains both fragments. */
+static inline void expect_read_fail(const char *path, int mesh, int rc,
+                                    const char *frag1, const char *frag2) {
+  char msg[512];
+  scf_points_t p;
+  uint32_t *tri = (uint32_t *)msg;
+  size_t nt = 5;
+  memset(msg, 'x', sizeof msg);
+  int got = mesh ? scf_mesh_read(path, &p, &tri, &nt, msg, sizeof msg)
+                 : scf_points_read(path, &p, msg, sizeof msg);
+  if (got != rc)
+    ASSERT_FAIL("reading %s: %s (%s), expected %s", path, scf_err_name(got),
+                got ? msg : "", scf_err_name(rc));
+  ASSERT(p.xyz == NULL);
+  ASSERT_EQ(p.count, 0);
+  if (mesh) {
+    ASSERT(tri == NULL);
+    ASSERT_EQ(nt, 0);
+  }
+  ASSERT(memchr(msg, '\0', sizeof msg) != NULL);
+  ASSERT(strchr(msg, '\n') == NULL);
+  if (strncmp(msg, path, strlen(path)) != 0 || msg[strlen(path)] != ':')
+    ASSERT_FAIL("\"%s\" does not start with \"%s:\"", msg, path);
+  if (frag1 != NULL)
+    ASSERT_STR_CONTAINS(msg, frag1);
+  if (frag2 != NULL)
+    ASSERT_STR_CONTAINS(msg, frag2);
 }
 
 #endif /* SC_TESTS_FILES_TMPDIR_H */
