@@ -44,6 +44,16 @@ stat_of() {
     sed -n "s/.*\"$2\": \([0-9]*\).*/\1/p"
 }
 
+# Waits up to a minute until daemon $1 has done at least $2 jobs.
+wait_jobs() {
+  local n=0
+  until [ "$(stat_of "$1" jobs_done_total)" -ge "$2" ] 2>/dev/null; do
+    n=$((n + 1))
+    [ "$n" -gt 600 ] && return 1
+    sleep 0.1
+  done
+}
+
 # Waits up to $2 tenths of a second for the text $1 in HAProxy's log.
 wait_log() {
   local n=0
@@ -87,12 +97,7 @@ jobs=150
   --jobs "$jobs" --points 4000 --jobs-in-flight 2 --retries 5 \
   --retry-backoff 100 --timeout 120 --verify --json >"$cl_dir/load.out" 2>&1 &
 load=$!
-n=0
-until [ "$(stat_of 2 jobs_done_total)" -ge 5 ] 2>/dev/null; do
-  n=$((n + 1))
-  [ "$n" -gt 600 ] && { fail "daemon 2 did no job"; break; }
-  sleep 0.1
-done
+wait_jobs 2 5 || fail "daemon 2 did no job"
 cluster_kill_daemon 2 KILL
 wait_log "d2 is DOWN" 150 || fail "HAProxy did not mark daemon 2 down"
 wait "$load"
@@ -122,12 +127,7 @@ wait_log "d2 is UP" 150 || fail "HAProxy did not mark daemon 2 up again"
   --timeout 120 --verify --json >"$cl_dir/load3.out" 2>&1 &
 load=$!
 before=$(stat_of 3 jobs_done_total)
-n=0
-until [ "$(stat_of 3 jobs_done_total)" -ge $((before + 3)) ] 2>/dev/null; do
-  n=$((n + 1))
-  [ "$n" -gt 600 ] && { fail "daemon 3 did no job"; break; }
-  sleep 0.1
-done
+wait_jobs 3 $((before + 3)) || fail "daemon 3 did no job"
 cluster_kill_daemon 3 TERM
 wait_log "d3 is DOWN" 150 || fail "HAProxy did not mark daemon 3 down"
 wait "$load" || fail "the run with a draining daemon: $(cat "$cl_dir/load3.out")"
