@@ -310,11 +310,11 @@ namespace dt {
 // The triangulation stages over tiles (tiles.cpp, section 17): fills out
 // and diag as Triangulator::filter() does, with the same candidates,
 // poles and numbering, from `tiles` tiles of the n points run on `threads`
-// threads (0: one per core), each holding the points within `margin` of
+// threads, each holding the points within `margin` of
 // its region from the start. Returns false, having done nothing that
 // counts, where the points cannot be split (too few) or span no volume:
 // the single triangulation then takes over.
-bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
+bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                   double margin, const sc_params_t &params, Progress &progress,
                   Filtered &out, sc_diag_t &diag,
                   double seconds[SC_STAGE_COUNT]);
@@ -340,6 +340,8 @@ private:
   // The tiles the triangulation stages run over (section 17), 0 for one
   // triangulation of all.
   size_t tile_count() const;
+  // The threads asked for, one per core for 0.
+  unsigned thread_count() const;
   void prepare(Progress &progress);
   sc_params_t params_;
   std::vector<double> own_;

@@ -241,11 +241,14 @@ bool Recon::defer_insertion() const {
 size_t Recon::tile_count() const {
   if (params_.tiles == 1 || detects_boundary(params_.mode))
     return 0;
-  const unsigned threads =
-      params_.threads > 0 ? unsigned(params_.threads)
-                          : std::max(1u, std::thread::hardware_concurrency());
-  const size_t k = params_.tiles > 0 ? size_t(params_.tiles) : threads;
+  const size_t k = params_.tiles > 0 ? size_t(params_.tiles) : thread_count();
   return k >= 2 ? k : 0;
+}
+
+unsigned Recon::thread_count() const {
+  return params_.threads > 0
+             ? unsigned(params_.threads)
+             : std::max(1u, std::thread::hardware_concurrency());
 }
 
 // Estimates the noise and, when denoising, smooths a copy of the points;
@@ -507,7 +510,7 @@ sc_mesh_t *Recon::finish() {
   // Tiles (section 17) hold each point near their region from the start:
   // the points within a few spacings.
   const bool tiled = !dt_ && tile_count() &&
-                     dt::tiled_filter(work, n_, tile_count(), params_.threads,
+                     dt::tiled_filter(work, n_, tile_count(), thread_count(),
                                       3 * noise_.spacing, params_, progress, f,
                                       diag, seconds_);
   if (!tiled) {

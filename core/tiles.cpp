@@ -226,7 +226,7 @@ struct Tile {
   std::vector<Ch> infinite;
   std::vector<uint32_t> tris;
   sc_diag_t diag;
-  size_t foreign = 0, rounds = 0, checked = 0;
+  size_t foreign = 0; // points of other tiles inserted
   Tile() { std::memset(&diag, 0, sizeof diag); }
 };
 
@@ -513,7 +513,6 @@ void check_cell(const Shared &s, Tile &t, const Ownership &own, Ch c,
   if (ball_in(t.reach, centre, r))
     return;
   const double r2 = r * r;
-  ++t.checked;
   const Point &p0 = c->vertex(0)->point(), &p1 = c->vertex(1)->point(),
               &p2 = c->vertex(2)->point(), &p3 = c->vertex(3)->point();
   // Of the points inside, the one nearest the centre goes in: it splits
@@ -548,7 +547,6 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own, Ch c,
   }
   if (!mine)
     return;
-  ++t.checked;
   const Point &pa = fv[0]->point(), &pb = fv[1]->point(), &pc = fv[2]->point();
   Ch in = c->neighbor(inf);
   const Point &po = in->vertex(in->index(c))->point();
@@ -603,14 +601,12 @@ void certify(const Shared &s, Tile &t, Progress &progress) {
       if (!checked_before(c))
         check_hull(s, t, own, c, add);
   }
-  ++t.rounds;
   std::vector<Ch> around;
   while (!add.empty()) {
     std::sort(add.begin(), add.end());
     add.erase(std::unique(add.begin(), add.end()), add.end());
     const std::vector<Vh> made = insert_foreign(s, t, add, progress);
     add.clear();
-    ++t.rounds;
     for (Vh v : made) {
       around.clear();
       t.dt.incident_cells(v, std::back_inserter(around));
@@ -629,7 +625,7 @@ void certify(const Shared &s, Tile &t, Progress &progress) {
 } // namespace
 
 // See internal.hpp.
-bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
+bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                   double margin, const sc_params_t &params, Progress &progress,
                   Filtered &out, sc_diag_t &diag,
                   double seconds[SC_STAGE_COUNT]) {
@@ -648,9 +644,6 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
   if (ts.size() < 2)
     return false;
   const size_t k = ts.size();
-  unsigned nthreads = threads > 0
-                          ? unsigned(threads)
-                          : std::max(1u, std::thread::hardware_concurrency());
   for (size_t i = 0; i < k; ++i) {
     ts[i].id = uint16_t(i);
     for (int a = 0; a < 3; ++a)
@@ -659,7 +652,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
   }
 
   // Phase 1: each tile's own points.
-  run_tiles(k, nthreads, progress,
+  run_tiles(k, threads, progress,
             [&](size_t i, Progress &p) { triangulate_own(xyz, ts[i], p); });
 
   // The vertex numbering of the single triangulation (its Hilbert order of
@@ -708,7 +701,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
   // hull and its margin, and certified.
   out.poles.assign(3 * m, 0.0);
   std::atomic<int> flat{0};
-  run_tiles(k, nthreads, progress, [&](size_t i, Progress &p) {
+  run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
     Tile &t = ts[i];
     for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
          ++v)
@@ -731,7 +724,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
 
   // Phase 3: poles, each tile's own into the shared array.
   progress.stage(SC_STAGE_POLES);
-  run_tiles(k, nthreads, progress, [&](size_t i, Progress &p) {
+  run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
     Tile &t = ts[i];
     const Ownership own{owner.data(), t.id};
     compute_poles(t.dt, t.infinite, p, t.diag, &own);
@@ -746,7 +739,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, int threads,
   // Phase 4: the candidates, each tile testing the facets it owns with the
   // poles of all.
   progress.stage(SC_STAGE_CANDIDATES);
-  run_tiles(k, nthreads, progress, [&](size_t i, Progress &p) {
+  run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
     Tile &t = ts[i];
     const Ownership own{owner.data(), t.id};
     for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
