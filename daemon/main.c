@@ -118,43 +118,6 @@ static int parse_u64(const char *s, uint64_t min, uint64_t max,
   return 0;
 }
 
-static int parse_bytes(const char *s, uint64_t *out) {
-  if (!*s || *s == '-' || *s == '+')
-    return -1;
-  char *end;
-  errno = 0;
-  unsigned long long v = strtoull(s, &end, 10);
-  if (errno || end == s)
-    return -1;
-  unsigned shift = 0;
-  switch (*end) {
-  case '\0':
-    break;
-  case 'k':
-  case 'K':
-    shift = 10;
-    break;
-  case 'M':
-    shift = 20;
-    break;
-  case 'G':
-    shift = 30;
-    break;
-  case 'T':
-    shift = 40;
-    break;
-  default:
-    return -1;
-  }
-  if (*end && end[1] != '\0' && strcmp(end + 1, "iB") != 0 &&
-      strcmp(end + 1, "B") != 0)
-    return -1;
-  if (shift && v > (UINT64_MAX >> shift))
-    return -1;
-  *out = (uint64_t)v << shift;
-  return *out ? 0 : -1;
-}
-
 enum {
   OPT_SOCKET = 256,
   OPT_SOCKET_MODE,
@@ -246,7 +209,7 @@ static int parse_args(int argc, char **argv, scd_config_t *cfg) {
       cfg->max_points = v;
       break;
     case OPT_MEMORY_BUDGET:
-      if (parse_bytes(optarg, &cfg->memory_budget))
+      if (scp_bytes_parse(optarg, &cfg->memory_budget))
         return bad_value("--memory-budget", optarg,
                          "want bytes, optionally with K, M, G or T");
       break;

@@ -1,14 +1,16 @@
 /*
  * Addresses of daemons: "unix://PATH" or a plain path, and
- * "tcp://HOST:PORT" (scproto.h). Only text: resolving a host and
- * connecting are the caller's.
+ * "tcp://HOST:PORT" (scproto.h), and sizes in bytes, as the command lines
+ * give them. Only text: resolving a host and connecting are the caller's.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
 #include "scproto.h"
 
+#include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static int parse_port(const char *s, uint16_t *out) {
@@ -104,4 +106,43 @@ char *scp_address_format(const scp_address_t *a, char *buf, size_t len) {
   if (rc < 0)
     buf[0] = '\0';
   return buf;
+}
+
+int scp_bytes_parse(const char *text, uint64_t *out) {
+  if (!text || !out)
+    return SCP_EINVAL;
+  if (text[0] < '0' || text[0] > '9')
+    return SCP_ERANGE;
+  char *end;
+  errno = 0;
+  unsigned long long v = strtoull(text, &end, 10);
+  if (errno)
+    return SCP_ERANGE;
+  unsigned shift = 0;
+  switch (*end) {
+  case '\0':
+    break;
+  case 'k':
+  case 'K':
+    shift = 10;
+    break;
+  case 'M':
+    shift = 20;
+    break;
+  case 'G':
+    shift = 30;
+    break;
+  case 'T':
+    shift = 40;
+    break;
+  default:
+    return SCP_ERANGE;
+  }
+  if (*end && end[1] != '\0' && strcmp(end + 1, "iB") != 0 &&
+      strcmp(end + 1, "B") != 0)
+    return SCP_ERANGE;
+  if (v == 0 || (shift && v > (UINT64_MAX >> shift)))
+    return SCP_ERANGE;
+  *out = (uint64_t)v << shift;
+  return 0;
 }

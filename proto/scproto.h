@@ -250,6 +250,13 @@ int scp_address_parse(const char *text, scp_address_t *out);
  * IPv6 host), cut to len - 1 bytes; returns buf. */
 char *scp_address_format(const scp_address_t *a, char *buf, size_t len);
 
+/* A size in bytes as the daemon's --memory-budget and the command's
+ * --memory-limit take it: digits, then optionally K, M, G or T (powers of
+ * 1024; k too), optionally followed by B or iB ("512M", "2GiB"). 0 with
+ * *out set (never 0 bytes); SCP_ERANGE for anything else, an overflow
+ * included; SCP_EINVAL for NULL. */
+int scp_bytes_parse(const char *text, uint64_t *out);
+
 /* Element formats of chunk frames. */
 typedef enum scp_format {
   SCP_F32_XYZ = 1,
