@@ -256,12 +256,21 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
   if (d->tiles)
     fprintf(f,
             "Tiles: %llu; %llu points triangulated in a second tile "
-            "(%.1f%%).\n",
+            "(%.1f%%)%s.\n",
             (unsigned long long)d->tiles,
             (unsigned long long)d->tile_points_foreign,
             d->delaunay_vertices ? 100.0 * (double)d->tile_points_foreign /
                                        (double)d->delaunay_vertices
-                                 : 0.0);
+                                 : 0.0,
+            r->params.memory_limit > 0
+                ? "; within the memory limit, a few at a time, each twice"
+                : "");
+  else if (r->params.memory_limit > 0)
+    fprintf(f, "Tiles: none, one triangulation: %s.\n",
+            r->params.mode == SC_MODE_COCONE ||
+                    r->params.mode == SC_MODE_SHORTCRUST
+                ? "it fits the memory limit"
+                : "this mode does not tile");
   else if (r->params.tiles != 1)
     fprintf(f, "Tiles: none, one triangulation: %s.\n",
             r->params.mode == SC_MODE_BOUNDARY ||

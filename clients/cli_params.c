@@ -11,10 +11,12 @@
  */
 #include <getopt.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "cli.h"
+#include "scproto.h"
 
 /* The options about the output, after the parameters. */
 static const struct option output_options[] = {
@@ -185,6 +187,17 @@ static int parse_row(sc_cli_job_opts_t *o, const param_row_t *r,
       return -1;
     *(int *)field = (int)l;
     return 0;
+  case SC_PARAM_BYTES: {
+    uint64_t b;
+    if (scp_bytes_parse(arg, &b) != 0) {
+      sc_cli_error("%s: expected a size in bytes such as 400000000, 512M or "
+                   "2G, got '%s'",
+                   opt, arg);
+      return -1;
+    }
+    *(double *)field = (double)b;
+    return 0;
+  }
   default:
     if (sc_cli_parse_double(opt, arg, &v) < 0)
       return -1;

@@ -140,6 +140,14 @@ int check_params(const sc_params_t *p, char *msg, size_t len) {
   }
   SC_PARAM_MAP(SC_CHECK_)
 #undef SC_CHECK_
+  if (p->memory_limit > 0 && as_number(p->mode) != SC_MODE_COCONE &&
+      as_number(p->mode) != SC_MODE_SHORTCRUST) {
+    set_msg(msg, len,
+            "memory_limit works in the cocone and shortcrust modes only (the "
+            "%s mode needs one triangulation of all the points)",
+            sc_mode_name(int(as_number(p->mode))));
+    return SC_EINVALID_ARGUMENT;
+  }
   return SC_OK;
 }
 

@@ -313,12 +313,20 @@ namespace dt {
 // threads, each holding the points within `margin` of
 // its region from the start. Returns false, having done nothing that
 // counts, where the points cannot be split (too few) or span no volume:
-// the single triangulation then takes over.
+// the single triangulation then takes over. bounded: at most `threads`
+// triangulations at a time (within a memory limit), each tile
+// triangulated twice.
 bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
-                  double margin, const sc_params_t &params, Progress &progress,
-                  Filtered &out, sc_diag_t &diag,
+                  bool bounded, double margin, const sc_params_t &params,
+                  Progress &progress, Filtered &out, sc_diag_t &diag,
                   double seconds[SC_STAGE_COUNT]);
 } // namespace dt
+
+// Within a memory limit of `limit` bytes (section 17.4): the tiles n points
+// need on `threads` threads, 1 where one triangulation of all fits. Throws
+// Error SC_ENO_MEMORY, saying what would fit, where not even tiles of the
+// least size fit.
+size_t memory_tiles(size_t n, unsigned threads, double limit);
 
 // One reconstruction, fed all at once or in chunks.
 class Recon {

@@ -233,15 +233,23 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
 // in chunks are inserted as they come, and inserted again, smoothed, only
 // if the estimate finds noise.)
 bool Recon::defer_insertion() const {
-  return params_.denoise != 0 || tile_count() != 0;
+  return params_.denoise != 0 || params_.memory_limit > 0 || tile_count() != 0;
 }
 
 // The boundary modes classify samples over the whole triangulation, and
-// run on one.
+// run on one. Within a memory limit the number of points decides
+// (memory_tiles()), at least as many as asked for.
 size_t Recon::tile_count() const {
-  if (params_.tiles == 1 || detects_boundary(params_.mode))
+  if (detects_boundary(params_.mode))
     return 0;
-  const size_t k = params_.tiles > 0 ? size_t(params_.tiles) : thread_count();
+  size_t k = params_.tiles == 1  ? 0
+             : params_.tiles > 0 ? size_t(params_.tiles)
+                                 : thread_count();
+  if (params_.memory_limit > 0) {
+    const size_t need = memory_tiles(n_, thread_count(), params_.memory_limit);
+    if (need >= 2)
+      k = std::max(k, need);
+  }
   return k >= 2 ? k : 0;
 }
 
@@ -326,6 +334,8 @@ void Recon::borrow(const double *xyz, size_t n) {
   check_finite(xyz, n, 0);
   xyz_ = xyz;
   n_ = n;
+  // A job that cannot fit its memory limit fails before it allocates.
+  (void)tile_count();
   seconds_[SC_STAGE_INPUT] += sw.lap();
   prepare(progress);
   if (!tile_count())
@@ -494,6 +504,7 @@ sc_mesh_t *Recon::finish() {
   // borrow() did not make them; as part of the insertion when points
   // were inserted as they came.
   if (!prepared_) {
+    (void)tile_count(); // a job that cannot fit fails before it allocates
     if (!dt_)
       progress.stage(SC_STAGE_INPUT);
     prepare(progress);
@@ -509,10 +520,11 @@ sc_mesh_t *Recon::finish() {
   Filtered f;
   // Tiles (section 17) hold each point near their region from the start:
   // the points within a few spacings.
-  const bool tiled = !dt_ && tile_count() &&
-                     dt::tiled_filter(work, n_, tile_count(), thread_count(),
-                                      3 * noise_.spacing, params_, progress, f,
-                                      diag, seconds_);
+  const bool tiled =
+      !dt_ && tile_count() &&
+      dt::tiled_filter(work, n_, tile_count(), thread_count(),
+                       params_.memory_limit > 0, 3 * noise_.spacing, params_,
+                       progress, f, diag, seconds_);
   if (!tiled) {
     f = Filtered();
     if (!dt_)

@@ -183,6 +183,13 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    as always. denoise_scale: the smoothing radius (0: estimated);
  *    smoothed_vertices: the mesh also carries the smoothed positions
  *    (sc_mesh_t.smoothed). Auto mode denoises by itself above the floor.
+ *  - memory_limit (cocone and shortcrust modes; 0 = none): the points are
+ *    split into as many tiles as it takes for `threads` of them at a time,
+ *    and what a reconstruction keeps besides, to stay near this many bytes
+ *    (the caller's copy of the points included); each tile is
+ *    triangulated twice, once for its poles and once for its candidates.
+ *    A job that cannot fit fails with SC_ENO_MEMORY before it allocates
+ *    (docs/algorithm.md section 17.4).
  *  - watertight_labels: 0 closes the holes with least-area patches and
  *    labels the Delaunay cells only where the patches cannot close the
  *    surface; 1 labels the cells first (inside or outside across the
@@ -218,6 +225,12 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "tiles", "N",                                                              \
     "split the points into N tiles triangulated apart, on the threads; the "   \
     "same mesh whatever N; 0 = one per thread (cocone and shortcrust modes)")  \
+  X(memory_limit, double, BYTES, 0, 0, 1e300,                                  \
+    SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "positive", LOCAL, 0,            \
+    "memory-limit", "BYTES",                                                   \
+    "keep the peak memory near BYTES (a number, or with K, M, G or T: powers " \
+    "of 1024) by triangulating tiles a few at a time, each twice; the same "   \
+    "mesh (cocone and shortcrust modes)")                                      \
   X(boundary_rho, double, REAL, 1.3, 0, 10,                                    \
     SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "in (0, 10]", OPTION, 0, "rho",  \
     "RHO", "boundary detection: ratio of cocone extent to pole height")        \
@@ -267,7 +280,8 @@ typedef enum sc_param_kind {
   SC_PARAM_REAL,
   SC_PARAM_ANGLE,
   SC_PARAM_INT,
-  SC_PARAM_FLAG
+  SC_PARAM_FLAG,
+  SC_PARAM_BYTES /* a double, in bytes; K, M, G, T on the command line */
 } sc_param_kind_t;
 typedef enum sc_param_wire {
   SC_PARAM_FIXED,

@@ -13,11 +13,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <mutex>
 #include <numeric>
+#include <string>
 #include <thread>
 
 namespace sc {
@@ -51,6 +54,7 @@ public:
     for (size_t i = 0; i < m; ++i)
       std::memcpy(&xyz_[3 * i], pts_ + 3 * size_t(idx_[i]), 3 * sizeof(double));
   }
+
   // The nearest to c of the points v within distance sqrt(r2) of c, outside
   // the box `skip`, that f(v) accepts; UINT32_MAX for none. Nearer parts
   // of the tree first, and the radius shrinks to each point accepted, so
@@ -225,6 +229,10 @@ struct Tile {
   std::vector<bool> member;
   std::vector<Ch> infinite;
   std::vector<uint32_t> tris;
+  // Within a memory limit: the vertex numbers of the tile's final
+  // triangulation, its own and the foreign ones certification took, kept
+  // between its two passes.
+  std::vector<uint32_t> vertices;
   sc_diag_t diag;
   size_t foreign = 0; // points of other tiles inserted
   Tile() { std::memset(&diag, 0, sizeof diag); }
@@ -394,6 +402,56 @@ void triangulate_own(const double *xyz, Tile &t, Progress &progress) {
       Ch c = t.dt.locate(p, lt, li, lj);
       d.second = c->vertex(li)->info().idx;
     }
+  }
+}
+
+// Within a memory limit no tile's own points are triangulated before the
+// numbering: the distinct points come from a sort instead. is_vertex[i]
+// is set for the first (smallest) index of each point, and each other
+// index is paired with it in dups, as the triangulations pair them.
+void distinct_points(const double *xyz, size_t n,
+                     std::vector<uint8_t> &is_vertex,
+                     std::vector<std::pair<uint32_t, uint32_t>> &dups) {
+  std::vector<uint32_t> idx(n);
+  std::iota(idx.begin(), idx.end(), 0u);
+  auto less = [&](uint32_t a, uint32_t b) {
+    const double *p = xyz + 3 * size_t(a), *q = xyz + 3 * size_t(b);
+    if (p[0] != q[0])
+      return p[0] < q[0];
+    if (p[1] != q[1])
+      return p[1] < q[1];
+    if (p[2] != q[2])
+      return p[2] < q[2];
+    return a < b;
+  };
+  std::sort(idx.begin(), idx.end(), less);
+  for (size_t k = 0; k < n;) {
+    const uint32_t first = idx[k];
+    const double *p = xyz + 3 * size_t(first);
+    is_vertex[first] = 1;
+    size_t e = k + 1;
+    for (; e < n; ++e) {
+      const double *q = xyz + 3 * size_t(idx[e]);
+      if (q[0] != p[0] || q[1] != p[1] || q[2] != p[2])
+        break;
+      dups.emplace_back(idx[e], first);
+    }
+    k = e;
+  }
+}
+
+// Triangulates the vertices `verts` (vertex numbers, ascending: a Hilbert
+// order) of pts into t.dt, in a biased randomized order.
+void triangulate_vertices(const double *pts, const std::vector<uint32_t> &verts,
+                          Tile &t, Progress &progress) {
+  const std::vector<uint32_t> order = brio_order(verts);
+  Ch hint;
+  for (size_t k = 0; k < order.size(); ++k) {
+    progress.tick(k, order.size());
+    const double *p = pts + 3 * size_t(order[k]);
+    Vh v = t.dt.insert(Point(p[0], p[1], p[2]), hint);
+    v->info() = VertexData(order[k]);
+    hint = v->cell();
   }
 }
 
@@ -624,10 +682,83 @@ void certify(const Shared &s, Tile &t, Progress &progress) {
 
 } // namespace
 
+} // namespace dt
+
+// Section 17.4: the memory of a reconstruction of n points, in bytes per
+// point, from the peak resident memory of `shortcrust reconstruct` (the
+// caller's copy of the points included) on the merged bunny scans and on
+// torus samples:
+//  - one triangulation of all (closed-surface samples: about 16 cells a
+//    vertex; scans about 6, and 750 bytes);
+constexpr double kUntiledBytes = 1850;
+//  - what a bounded run keeps while the tiles run: the points, their
+//    numbering and k-d tree, poles and candidates;
+constexpr double kFixedBytes = 200;
+//  - the stages after the triangulation (pruning's and extraction's edge
+//    tables over the candidates), which no tiling makes smaller;
+constexpr double kAfterBytes = 640;
+//  - a tile's triangulation, by the points in it, and the points a tile
+//    holds over its own (1.1 to 1.3 on scans, up to 1.9 on closed
+//    samples, whose large inner cells reach across the seams).
+constexpr double kTileBytes = 1500;
+constexpr double kTileGrowth = 2.0;
+
+namespace {
+// A size for a message: "5.6 MB", or bytes below a tenth of a megabyte.
+std::string size_text(double bytes) {
+  char buf[32];
+  if (bytes < 104857.6)
+    std::snprintf(buf, sizeof buf, "%.0f bytes", bytes);
+  else
+    std::snprintf(buf, sizeof buf, "%.1f MB", bytes / 1048576);
+  return buf;
+}
+} // namespace
+
+size_t memory_tiles(size_t n, unsigned threads, double limit) {
+  const double pts = double(n);
+  if (limit >= kUntiledBytes * pts)
+    return 1;
+  // Tiles are split down to dt::kMinTilePoints at most: the most tiles
+  // give the least memory.
+  const double most =
+      std::min(std::floor(pts / double(dt::kMinTilePoints)), 4096.0);
+  const double per_tile_point = kTileBytes * kTileGrowth * double(threads);
+  const double room = limit - kFixedBytes * pts;
+  const double k =
+      std::max(2.0, room > 0 ? std::ceil(per_tile_point * pts / room) : 0.0);
+  if (most >= 2 && room > 0 && k <= most && kAfterBytes * pts <= limit)
+    return size_t(k);
+  char buf[320];
+  if (most < 2) {
+    std::snprintf(buf, sizeof buf,
+                  "%zu points are too few to split into tiles (%zu a tile), "
+                  "and one triangulation of them needs a memory limit of at "
+                  "least %s, got %s",
+                  n, dt::kMinTilePoints, size_text(kUntiledBytes * pts).c_str(),
+                  size_text(limit).c_str());
+    throw Error(SC_ENO_MEMORY, buf);
+  }
+  const double least_tile = pts / most;
+  const double need = std::max(kFixedBytes * pts + per_tile_point * least_tile,
+                               kAfterBytes * pts);
+  std::snprintf(buf, sizeof buf,
+                "%zu points need a memory limit of at least %s, got %s (the "
+                "stages after the triangulation take about %.0f bytes a "
+                "point whatever the tiles, and %u tile%s of %.0f points at a "
+                "time %s)",
+                n, size_text(need).c_str(), size_text(limit).c_str(),
+                kAfterBytes, threads, threads == 1 ? "" : "s", least_tile,
+                size_text(per_tile_point * least_tile).c_str());
+  throw Error(SC_ENO_MEMORY, buf);
+}
+
+namespace dt {
+
 // See internal.hpp.
 bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
-                  double margin, const sc_params_t &params, Progress &progress,
-                  Filtered &out, sc_diag_t &diag,
+                  bool bounded, double margin, const sc_params_t &params,
+                  Progress &progress, Filtered &out, sc_diag_t &diag,
                   double seconds[SC_STAGE_COUNT]) {
   Stopwatch sw;
   progress.stage(SC_STAGE_DELAUNAY);
@@ -651,21 +782,27 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
       ts[i].reach.hi[a] = ts[i].region.hi[a] + margin;
   }
 
-  // Phase 1: each tile's own points.
-  run_tiles(k, threads, progress,
-            [&](size_t i, Progress &p) { triangulate_own(xyz, ts[i], p); });
+  // Phase 1: each tile's own points, which also tell the distinct points.
+  // Within a memory limit no triangulation is kept between phases: a sort
+  // tells them.
+  std::vector<uint8_t> is_vertex(n, 0);
+  if (bounded) {
+    distinct_points(xyz, n, is_vertex, out.dups);
+  } else {
+    run_tiles(k, threads, progress,
+              [&](size_t i, Progress &p) { triangulate_own(xyz, ts[i], p); });
+    for (Tile &t : ts) {
+      for (auto v = t.dt.finite_vertices_begin();
+           v != t.dt.finite_vertices_end(); ++v)
+        is_vertex[v->info().idx] = 1;
+      out.dups.insert(out.dups.end(), t.dups.begin(), t.dups.end());
+      t.dups = {};
+    }
+  }
+  diag.duplicates_merged = out.dups.size();
 
   // The vertex numbering of the single triangulation (its Hilbert order of
   // all the points, the first of equal points standing for them).
-  std::vector<uint8_t> is_vertex(n, 0);
-  for (Tile &t : ts) {
-    for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
-         ++v)
-      is_vertex[v->info().idx] = 1;
-    out.dups.insert(out.dups.end(), t.dups.begin(), t.dups.end());
-    t.dups = {};
-  }
-  diag.duplicates_merged = out.dups.size();
   {
     std::vector<uint32_t> order(n);
     std::iota(order.begin(), order.end(), 0u);
@@ -701,11 +838,21 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
   // hull and its margin, and certified.
   out.poles.assign(3 * m, 0.0);
   std::atomic<int> flat{0};
-  run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
-    Tile &t = ts[i];
-    for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
-         ++v)
-      v->info() = VertexData(rank[v->info().idx]);
+  auto grow = [&](Tile &t, Progress &p) {
+    if (bounded) {
+      std::vector<uint32_t> mine;
+      mine.reserve(t.own.size());
+      for (uint32_t i : t.own)
+        if (rank[i] != UINT32_MAX)
+          mine.push_back(rank[i]);
+      t.own = {};
+      std::sort(mine.begin(), mine.end());
+      triangulate_vertices(pts.data(), mine, t, p);
+    } else {
+      for (auto v = t.dt.finite_vertices_begin();
+           v != t.dt.finite_vertices_end(); ++v)
+        v->info() = VertexData(rank[v->info().idx]);
+    }
     t.member.assign(m, false);
     std::vector<uint32_t> add;
     for (size_t v = 0; v < m; ++v)
@@ -714,33 +861,24 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
     (void)insert_foreign(shared, t, add, p);
     if (t.dt.dimension() < 3) {
       flat = 1;
-      return;
+      return false;
     }
     certify(shared, t, p);
-  });
-  if (flat.load())
-    return false;
-  seconds[SC_STAGE_DELAUNAY] += sw.lap();
-
+    return true;
+  };
   // Phase 3: poles, each tile's own into the shared array.
-  progress.stage(SC_STAGE_POLES);
-  run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
-    Tile &t = ts[i];
+  auto poles = [&](Tile &t, Progress &p, sc_diag_t &d) {
     const Ownership own{owner.data(), t.id};
-    compute_poles(t.dt, t.infinite, p, t.diag, &own);
+    compute_poles(t.dt, t.infinite, p, d, &own);
     for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
          ++v)
       if (own(v->info().idx))
         std::memcpy(&out.poles[3 * size_t(v->info().idx)], v->info().pole,
                     sizeof v->info().pole);
-  });
-  seconds[SC_STAGE_POLES] += sw.lap();
-
+  };
   // Phase 4: the candidates, each tile testing the facets it owns with the
   // poles of all.
-  progress.stage(SC_STAGE_CANDIDATES);
-  run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
-    Tile &t = ts[i];
+  auto candidates = [&](Tile &t, Progress &p) {
     const Ownership own{owner.data(), t.id};
     for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
          ++v)
@@ -749,8 +887,58 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                     sizeof v->info().pole);
     select_candidates(t.dt, t.infinite, params, p, t.tris, t.diag, &own);
     t.dt.clear();
+    t.infinite = {};
     t.member = {};
-  });
+  };
+  if (bounded) {
+    // Within a memory limit, `threads` tiles at a time: the first pass
+    // grows, certifies and takes the poles of each tile, keeps its vertex
+    // set and drops the triangulation; the second triangulates the same
+    // vertices again (the same cells: they are certified) and tests its
+    // facets once every pole is known.
+    run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
+      Tile &t = ts[i];
+      if (!grow(t, p))
+        return;
+      sc_diag_t scratch;
+      std::memset(&scratch, 0, sizeof scratch);
+      poles(t, p, scratch);
+      t.vertices.reserve(t.dt.number_of_vertices());
+      for (auto v = t.dt.finite_vertices_begin();
+           v != t.dt.finite_vertices_end(); ++v)
+        t.vertices.push_back(v->info().idx);
+      t.dt.clear();
+      t.infinite = {};
+      t.member = {};
+    });
+    if (flat.load())
+      return false;
+    seconds[SC_STAGE_DELAUNAY] += sw.lap();
+    progress.stage(SC_STAGE_CANDIDATES);
+    run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
+      Tile &t = ts[i];
+      std::sort(t.vertices.begin(), t.vertices.end());
+      triangulate_vertices(pts.data(), t.vertices, t, p);
+      t.vertices = {};
+      const Ownership own{owner.data(), t.id};
+      compute_poles(t.dt, t.infinite, p, t.diag, &own);
+      candidates(t, p);
+    });
+  } else {
+    run_tiles(k, threads, progress,
+              [&](size_t i, Progress &p) { (void)grow(ts[i], p); });
+    if (flat.load())
+      return false;
+    seconds[SC_STAGE_DELAUNAY] += sw.lap();
+    progress.stage(SC_STAGE_POLES);
+    run_tiles(k, threads, progress,
+              [&](size_t i, Progress &p) { poles(ts[i], p, ts[i].diag); });
+    seconds[SC_STAGE_POLES] += sw.lap();
+    progress.stage(SC_STAGE_CANDIDATES);
+    run_tiles(k, threads, progress,
+              [&](size_t i, Progress &p) { candidates(ts[i], p); });
+  }
+
   size_t total = 0;
   for (const Tile &t : ts)
     total += t.tris.size();

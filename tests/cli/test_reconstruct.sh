@@ -11,7 +11,7 @@ trap 'rm -rf "$tmp"' EXIT
 knot=$data/knot1_points.ply
 expect 0 "usage: shortcrust reconstruct" "$sc" reconstruct --help
 for opt in --output --mode --r --theta --max-hole --paper-pruning --threads \
-           --denoise --denoise-scale --smoothed-vertices \
+           --denoise --denoise-scale --smoothed-vertices --tiles --memory-limit \
            --report --ascii --no-normals --quiet .las .laz; do
   grep -q -- "$opt" "$tmp/out" || fail "--help does not mention $opt"
 done
@@ -128,6 +128,23 @@ expect 0 "denoised at scale 0.05" "$sc" reconstruct "$knot" -o "$tmp/d.ply" --de
 expect 2 "denoise-scale: must be positive, got -1" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --denoise --denoise-scale -1
 expect 2 "denoise-scale: 'abc' is not a finite number" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --denoise-scale abc
 expect 2 "denoise-scale: 'nan' is not a finite number" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --denoise-scale nan
+
+# --memory-limit: sizes with suffixes; the same mesh within the limit, or a
+# clear refusal before the work starts.
+"$sc" reconstruct "$data/bunny_points.ply" -o "$tmp/b0.ply" -q ||
+  fail "bunny, no limit"
+expect 0 "within the memory limit" "$sc" reconstruct "$data/bunny_points.ply" \
+  -o "$tmp/b1.ply" --memory-limit 40M
+cmp -s "$tmp/b0.ply" "$tmp/b1.ply" || fail "--memory-limit 40M: another mesh"
+expect 0 "it fits the memory limit" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --memory-limit 1GiB
+rm -f "$tmp/x.ply"
+expect 1 "need a memory limit of at least .* MB, got 1.0 MB" "$sc" reconstruct "$data/bunny_points.ply" -o "$tmp/x.ply" --memory-limit 1M
+[ -e "$tmp/x.ply" ] && fail "a refused job wrote its output"
+for bad in abc 0 -5 12X 1MBs 99999999999999999999; do
+  expect 2 "memory-limit: expected a size in bytes" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --memory-limit "$bad"
+done
+expect 2 "memory_limit works in the cocone and shortcrust modes only" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --mode watertight --memory-limit 1G
+rm -f "$tmp/b0.ply" "$tmp/b1.ply" "$tmp/x.ply"
 expect 2 "no input file" "$sc" reconstruct -o "$tmp/x.ply"
 expect 2 "no output file" "$sc" reconstruct "$knot"
 expect 2 "unknown mode 'foo'" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --mode foo

@@ -178,6 +178,50 @@ cancel : {
   }
 }
 
+  /* Within a memory limit: tiles a few at a time, each triangulated
+   * twice, the same mesh; a limit one triangulation fits runs untiled; one
+   * nothing fits fails before it starts, and so does a mode that cannot
+   * tile. */
+  {
+    sc_mesh_t *one = run("torus", xyz, n, SC_MODE_COCONE, 1, 1);
+    const int threads[] = {1, 2};
+    for (size_t k = 0; one && k < 2; ++k) {
+      sc_params_t p;
+      sc_params_init(&p);
+      p.threads = threads[k];
+      p.memory_limit = 16 << 20;
+      sc_mesh_t *t = NULL;
+      char msg[256] = "";
+      EXPECT_EQ(sc_reconstruct(xyz, n, &p, &t, msg, sizeof msg), SC_OK);
+      if (t)
+        same("torus within 16 MB", one, t, (int)t->diag.tiles, threads[k]);
+      sc_mesh_free(t);
+    }
+    sc_mesh_free(one);
+    sc_params_t p;
+    sc_params_init(&p);
+    p.memory_limit = 1e9;
+    sc_mesh_t *t = NULL;
+    char msg[256] = "";
+    EXPECT_EQ(sc_reconstruct(xyz, n, &p, &t, msg, sizeof msg), SC_OK);
+    if (t)
+      EXPECT_EQ(t->diag.tiles, 0);
+    sc_mesh_free(t);
+    t = NULL;
+    p.memory_limit = 1 << 20;
+    EXPECT_EQ(sc_reconstruct(xyz, n, &p, &t, msg, sizeof msg), SC_ENO_MEMORY);
+    EXPECT_NULL(t);
+    EXPECT_NOT_NULL(strstr(msg, "need a memory limit of at least"));
+    printf("ok: 1 MB refused: %s\n", msg);
+    p.mode = SC_MODE_WATERTIGHT;
+    p.memory_limit = 1e9;
+    EXPECT_EQ(sc_params_check(&p, msg, sizeof msg), SC_EINVALID_ARGUMENT);
+    EXPECT_NOT_NULL(strstr(msg, "cocone and shortcrust modes only"));
+    EXPECT_EQ(sc_reconstruct(xyz, n, &p, &t, msg, sizeof msg),
+              SC_EINVALID_ARGUMENT);
+    EXPECT_NULL(t);
+  }
+
   /* The boundary modes run one triangulation whatever the tiles. */
   {
     sc_mesh_t *b = run("torus", xyz, n, SC_MODE_BOUNDARY, 4, 1);
