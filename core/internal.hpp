@@ -322,7 +322,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                   double seconds[SC_STAGE_COUNT]);
 } // namespace dt
 
-// Within a memory limit of `limit` bytes (section 17.4): the tiles n points
+// Within a memory limit of `limit` bytes (section 17.5): the tiles n points
 // need on `threads` threads, 1 where one triangulation of all fits. Throws
 // Error SC_ENO_MEMORY, saying what would fit, where not even tiles of the
 // least size fit.

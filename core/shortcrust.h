@@ -189,7 +189,7 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    (the caller's copy of the points included); each tile is
  *    triangulated twice, once for its poles and once for its candidates.
  *    A job that cannot fit fails with SC_ENO_MEMORY before it allocates
- *    (docs/algorithm.md section 17.4).
+ *    (docs/algorithm.md section 17.5).
  *  - watertight_labels: 0 closes the holes with least-area patches and
  *    labels the Delaunay cells only where the patches cannot close the
  *    surface; 1 labels the cells first (inside or outside across the

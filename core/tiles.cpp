@@ -684,7 +684,7 @@ void certify(const Shared &s, Tile &t, Progress &progress) {
 
 } // namespace dt
 
-// Section 17.4: the memory of a reconstruction of n points, in bytes per
+// Section 17.5: the memory of a reconstruction of n points, in bytes per
 // point, from the peak resident memory of `shortcrust reconstruct` (the
 // caller's copy of the points included) on the merged bunny scans and on
 // torus samples:
