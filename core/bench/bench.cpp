@@ -38,12 +38,14 @@ struct Result {
   double cpu_seconds; // user + system time of the measurement's process
   double stage[SC_STAGE_COUNT];
   double peak_bytes; // above the resident set at the start
+  double base_bytes; // the resident set at the start
   uint64_t triangles, unused, components, boundary_edges;
   int closed, manifold;
   int64_t genus;
   int mesh; // the fields above describe an output mesh
   uint64_t tiles, foreign, vertices; // tiled runs: the overhead
   uint64_t hash; // of the triangles, to tell a different mesh
+  char msg[240]; // why the reconstruction failed
 };
 
 double now() {
@@ -99,6 +101,7 @@ template <class F> Result in_child(F f) {
     f(res);
     res.cpu_seconds = cpu_now() - cpu0;
     res.peak_bytes = 1024.0 * double(status_kb("VmHWM") - base);
+    res.base_bytes = 1024.0 * double(base);
     ssize_t w = write(fd[1], &res, sizeof res);
     _exit(w == sizeof res ? 0 : 1);
   }
@@ -152,6 +155,7 @@ struct Job {
   int mode = SC_MODE_COCONE;
   int denoise = 0;
   int tiles = 1;
+  double memory_limit = 0; // bytes
 };
 
 Result run_shortcrust(const double *xyz, size_t n, int threads,
@@ -163,12 +167,13 @@ Result run_shortcrust(const double *xyz, size_t n, int threads,
     p.tiles = job.tiles;
     p.mode = sc_mode_t(job.mode);
     p.denoise = job.denoise;
+    p.memory_limit = job.memory_limit;
     sc_mesh_t *m = nullptr;
     double t0 = now();
-    int rc = sc_reconstruct(xyz, n, &p, &m, nullptr, 0);
+    int rc = sc_reconstruct(xyz, n, &p, &m, r.msg, sizeof r.msg);
     r.seconds = now() - t0;
     if (rc != 0)
-      return;
+      return; // r.msg says why
     for (int s = 0; s < SC_STAGE_COUNT; ++s)
       r.stage[s] = m->diag.seconds[s];
     check_mesh(n, xyz, m->triangles, m->triangle_count, r);
@@ -208,8 +213,9 @@ void usage(FILE *f) {
       "[--density NAME]\n"
       "                        [--noise SIGMA] [--input FILE] [--mode MODE] "
       "[--denoise]\n"
-      "                        [--threads N] [--tiles N] [--no-peer] "
-      "[--peer-max N] [--seed S]\n\n"
+      "                        [--threads N] [--tiles N] "
+      "[--memory-limit F] [--no-peer]\n"
+      "                        [--peer-max N] [--seed S]\n\n"
       "Times the reconstruction stage by stage on generated samples and "
       "prints, per size,\n"
       "its time and peak memory against CGAL's Delaunay construction of "
@@ -230,6 +236,12 @@ void usage(FILE *f) {
       "               and on --threads, and compare their meshes with the "
       "single\n"
       "               triangulation's\n"
+      "  --memory-limit  also run with --memory-limit at F times the peak "
+      "resident\n"
+      "               memory of the untiled run (one thread; F in (0, 1)), "
+      "and compare\n"
+      "               its mesh and peak with it (docs/algorithm.md section "
+      "17.5)\n"
       "  --no-peer    skip the advancing front\n"
       "  --peer-max   run the advancing front only up to this many points\n"
       "               (default 1000000)\n"
@@ -269,6 +281,7 @@ int main(int argc, char **argv) {
   int surface = SCS_SURF_TORUS, density = SCS_DENSITY_UNIFORM_RANDOM;
   int threads = int(std::thread::hardware_concurrency());
   int tiles = 1;
+  double limit_fraction = 0;
   bool peer = true;
   size_t peer_max = 1000000;
   uint64_t seed = 1;
@@ -308,6 +321,13 @@ int main(int argc, char **argv) {
       threads = std::atoi(value());
     } else if (a == "--tiles") {
       tiles = std::atoi(value());
+    } else if (a == "--memory-limit") {
+      limit_fraction = std::atof(value());
+      if (!(limit_fraction > 0 && limit_fraction < 1)) {
+        std::fprintf(stderr, "shortcrust-bench: --memory-limit takes a "
+                             "fraction in (0, 1)\n");
+        return 2;
+      }
     } else if (a == "--no-peer") {
       peer = false;
     } else if (a == "--peer-max") {
@@ -425,6 +445,36 @@ int main(int argc, char **argv) {
                   same ? "same mesh" : "A DIFFERENT MESH");
       if (!same)
         failed = true;
+    }
+    // Within a memory limit, a fraction of the untiled run's peak (the
+    // whole process's, as the limit counts it).
+    if (limit_fraction > 0 && one.ok) {
+      Job lj = job;
+      const double untiled = one.base_bytes + one.peak_bytes;
+      lj.memory_limit = limit_fraction * untiled;
+      Result lr = run_shortcrust(xyz.data(), n, 1, lj);
+      char name[64];
+      std::snprintf(name, sizeof name, "memory limit %.2f", limit_fraction);
+      if (!lr.ok && lr.msg[0]) {
+        std::printf("  %-24s %.1f MB of the untiled %.1f MB: refused: %s\n",
+                    name, lj.memory_limit / 1048576, untiled / 1048576, lr.msg);
+      } else {
+        print_row(name, lr, n);
+        if (lr.ok) {
+          const bool same =
+              lr.triangles == one.triangles && lr.hash == one.hash;
+          const double peak = lr.base_bytes + lr.peak_bytes;
+          std::printf("    limit %.1f MB (untiled peak %.1f MB): %llu tiles, "
+                      "peak %.1f MB = %.2f of the limit (target <= 1.3), "
+                      "time / untiled %.2f, %s\n",
+                      lj.memory_limit / 1048576, untiled / 1048576,
+                      (unsigned long long)lr.tiles, peak / 1048576,
+                      peak / lj.memory_limit, lr.seconds / one.seconds,
+                      same ? "same mesh" : "A DIFFERENT MESH");
+          if (!same)
+            failed = true;
+        }
+      }
     }
     Result af{};
     if (peer && n <= peer_max) {
