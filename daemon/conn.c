@@ -126,6 +126,10 @@ void scd_conn_close_now(scd_conn_t *c, const char *reason) {
     c->srv->conns_open--;
     c->counted = 0;
   }
+  if (c->waiting) {
+    c->srv->tcp_waiting--;
+    c->waiting = 0;
+  }
   /* A balancer's health check opens a TCP connection every second or so,
    * and runs no job: those come and go at debug level, so that the log
    * keeps the clients' connections (a refused token is a warning). */
@@ -353,6 +357,10 @@ static void on_hello(scd_conn_t *c, const scp_frame_t *f) {
   c->out.max_frame = c->wbuf.max_frame = w.max_frame;
   c->state = SCD_CONN_READY;
   c->deadline_ns = 0;
+  if (c->waiting) {
+    srv->tcp_waiting--;
+    c->waiting = 0;
+  }
   scd_log(c->tcp ? SCD_LOG_DEBUG : SCD_LOG_INFO,
           "conn %llu: ready (version %u, max_frame %u)", (ull)c->id, w.version,
           w.max_frame);
@@ -568,8 +576,27 @@ void scd_conn_accept(scd_server_t *srv, uv_stream_t *listener, int tcp) {
                    srv->cfg.max_connections);
     return;
   }
+  /* A peer that connects and says nothing holds its place until the
+   * handshake timeout. On TCP anyone who can reach the port can do that, so
+   * connections still before their WELCOME may take at most a quarter of
+   * the places, and the rest stay for clients that authenticate (as
+   * sshd's MaxStartups does). */
+  const unsigned waiting_max =
+      srv->cfg.max_connections / 4 ? srv->cfg.max_connections / 4 : 1;
+  if (tcp && srv->tcp_waiting >= waiting_max) {
+    srv->n.connections_refused_total++;
+    scd_conn_fatal(c, SCP_WIRE_BUSY, 0, 0,
+                   "too many TCP connections before their handshake (at most "
+                   "%u, a quarter of --max-connections); try later",
+                   waiting_max);
+    return;
+  }
   c->counted = 1;
   srv->conns_open++;
+  if (tcp) {
+    c->waiting = 1;
+    srv->tcp_waiting++;
+  }
   c->deadline_ns = c->open_ns + srv->cfg.handshake_ms * 1000000u;
   if (tcp)
     scd_debug("conn %llu: accepted from %s over TCP (%u open)", (ull)c->id,

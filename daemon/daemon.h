@@ -106,6 +106,7 @@ typedef struct scd_server {
 
   scd_conn_t *conns;       /* every open connection */
   unsigned conns_open;     /* counted against --max-connections */
+  unsigned tcp_waiting;    /* of those, TCP ones before their WELCOME */
   uint64_t next_conn_id;
 
   uint64_t tasks_in_pool;  /* submitted and not yet handed back */
@@ -171,6 +172,7 @@ struct scd_conn {
   uint64_t id;
   int state;
   int counted;             /* counts against --max-connections */
+  int waiting;             /* counts in tcp_waiting */
   int reading;             /* uv_read_start() in force */
   int broken;              /* out of memory for output: close at flush */
   scp_decoder_t *dec;

@@ -82,7 +82,8 @@ void scd_server_free_task(scd_server_t *srv, scd_task_t *t) {
  *
  *   connections                 connections open now (refused ones aside)
  *   connections_total           connections accepted, refused ones included
- *   connections_refused_total   refused for --max-connections
+ *   connections_refused_total   refused for --max-connections, or for
+ *                               too many TCP connections before WELCOME
  *   jobs_active                 jobs holding memory: queued, running, or
  *                               sending their mesh
  *   jobs_accepted_total         JOB_BEGINs answered with ACCEPTED

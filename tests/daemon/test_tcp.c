@@ -4,6 +4,7 @@
  * right one get a fatal ERROR AUTH and nothing else, not even a PONG for a
  * PING sent behind the HELLO; each refusal is counted in STATS and logged
  * without the token; on the Unix socket a token is ignored, wrong or not.
+ * TCP peers that say nothing hold at most a quarter of the connections.
  * The daemon refuses to start with a TCP listener and no token file, and
  * with a token file that group or others may read or that holds too short
  * a token.
@@ -135,6 +136,56 @@ static void tcp_and_unix(void) {
   EXPECT_EQ(scdt_daemon_stop(&d), 0);
 }
 
+/* Peers that connect over TCP and say nothing hold at most a quarter of
+ * --max-connections: the next TCP connection gets BUSY, while the Unix
+ * socket, and TCP again once they leave, still serve. */
+static void silent_peers(void) {
+  scdt_daemon_t d;
+  ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
+  char token_file[200], addr[64];
+  snprintf(token_file, sizeof token_file, "%s/token", d.dir);
+  ASSERT_EQ(scdt_write_file(token_file, TOKEN "\n", 0600), 0);
+  const char *args[] = {"--listen", "tcp://127.0.0.1:0", "--token-file",
+                        token_file, "--max-connections", "8",
+                        NULL};
+  ASSERT_MSG(scdt_daemon_spawn(&d, args, 1) == 0, "daemon did not start");
+  tcp_address(&d, addr, sizeof addr);
+
+  /* One client in, then two silent peers: the quarter of 8. */
+  scdt_conn_t *in, *quiet[2], *c;
+  ASSERT_EQ(hello_with(addr, TOKEN, strlen(TOKEN), &in), 0);
+  for (int i = 0; i < 2; ++i)
+    ASSERT_EQ(scdt_connect(addr, &quiet[i]), 0);
+  /* The listener accepts in order: both are in before the next. */
+  EXPECT_EQ(hello_with(addr, TOKEN, strlen(TOKEN), &c), SCP_WIRE_BUSY);
+  EXPECT_MSG(strstr(c->last_error.message, "before their handshake") != NULL,
+             "BUSY says '%s'", c->last_error.message);
+  scdt_close(c);
+  ASSERT_EQ(hello_with(d.sock, NULL, 0, &c), 0);
+  scdt_run_ok(c, 1, SCS_SURF_SPHERE, sphere, 2000, T_MS, "Unix, peers silent");
+  scdt_close(c);
+  scdt_run_ok(in, 1, SCS_SURF_SPHERE, sphere, 2000, T_MS,
+              "TCP client in before the silent peers");
+  EXPECT_EQ(scdt_stat_fresh(d.sock, "connections_refused_total"), 1);
+
+  /* Once they leave, TCP serves again. */
+  for (int i = 0; i < 2; ++i)
+    scdt_close(quiet[i]);
+  int rc = -1;
+  for (int tries = 0; tries < 100 && rc != 0; ++tries) {
+    rc = hello_with(addr, TOKEN, strlen(TOKEN), &c);
+    if (rc != 0) {
+      scdt_close(c);
+      scdt_sleep_ms(20);
+    }
+  }
+  ASSERT_EQ(rc, 0);
+  scdt_run_ok(c, 1, SCS_SURF_SPHERE, sphere, 2000, T_MS, "TCP, peers gone");
+  scdt_close(c);
+  scdt_close(in);
+  EXPECT_EQ(scdt_daemon_stop(&d), 0);
+}
+
 /* Start-up: a TCP listener needs a token file, and the file must be the
  * daemon's alone and hold a token long enough. */
 static void refuses_to_start(void) {
@@ -177,6 +228,7 @@ int main(int argc, char **argv) {
   scdt_init(argc, argv);
   sphere = scdt_sample(SCS_SURF_SPHERE, 2000, 1);
   tcp_and_unix();
+  silent_peers();
   refuses_to_start();
   free(sphere);
   return scdt_finish();
