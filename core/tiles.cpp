@@ -876,6 +876,12 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
         std::memcpy(&out.poles[3 * size_t(v->info().idx)], v->info().pole,
                     sizeof v->info().pole);
   };
+  // A tile's triangulation and what points into it, freed.
+  auto drop = [](Tile &t) {
+    t.dt.clear();
+    t.infinite = {};
+    t.member = {};
+  };
   // Phase 4: the candidates, each tile testing the facets it owns with the
   // poles of all.
   auto candidates = [&](Tile &t, Progress &p) {
@@ -886,9 +892,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
         std::memcpy(v->info().pole, &out.poles[3 * size_t(v->info().idx)],
                     sizeof v->info().pole);
     select_candidates(t.dt, t.infinite, params, p, t.tris, t.diag, &own);
-    t.dt.clear();
-    t.infinite = {};
-    t.member = {};
+    drop(t);
   };
   if (bounded) {
     // Within a memory limit, `threads` tiles at a time: the first pass
@@ -907,9 +911,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
       for (auto v = t.dt.finite_vertices_begin();
            v != t.dt.finite_vertices_end(); ++v)
         t.vertices.push_back(v->info().idx);
-      t.dt.clear();
-      t.infinite = {};
-      t.member = {};
+      drop(t);
     });
     if (flat.load())
       return false;
