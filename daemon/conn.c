@@ -113,6 +113,14 @@ static void on_closed(uv_handle_t *h) {
   scd_server_maybe_finish(srv);
 }
 
+/* The connection no longer counts among the TCP ones before WELCOME. */
+static void stop_waiting(scd_conn_t *c) {
+  if (c->waiting) {
+    c->srv->tcp_waiting--;
+    c->waiting = 0;
+  }
+}
+
 void scd_conn_close_now(scd_conn_t *c, const char *reason) {
   if (c->state == SCD_CONN_CLOSED)
     return;
@@ -126,10 +134,7 @@ void scd_conn_close_now(scd_conn_t *c, const char *reason) {
     c->srv->conns_open--;
     c->counted = 0;
   }
-  if (c->waiting) {
-    c->srv->tcp_waiting--;
-    c->waiting = 0;
-  }
+  stop_waiting(c);
   /* A balancer's health check opens a TCP connection every second or so,
    * and runs no job: those come and go at debug level, so that the log
    * keeps the clients' connections (a refused token is a warning). */
@@ -357,10 +362,7 @@ static void on_hello(scd_conn_t *c, const scp_frame_t *f) {
   c->out.max_frame = c->wbuf.max_frame = w.max_frame;
   c->state = SCD_CONN_READY;
   c->deadline_ns = 0;
-  if (c->waiting) {
-    srv->tcp_waiting--;
-    c->waiting = 0;
-  }
+  stop_waiting(c);
   scd_log(c->tcp ? SCD_LOG_DEBUG : SCD_LOG_INFO,
           "conn %llu: ready (version %u, max_frame %u)", (ull)c->id, w.version,
           w.max_frame);
