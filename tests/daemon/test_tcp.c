@@ -67,16 +67,28 @@ static void expect_refused(const char *addr, const char *token, size_t len,
   scdt_close(c);
 }
 
+/* A daemon listening on a free loopback port with TOKEN in its token file,
+ * and --max-connections max_conns unless NULL; its address in addr. */
+static void spawn_tcp(scdt_daemon_t *d, const char *max_conns, char *addr,
+                      size_t len) {
+  ASSERT_MSG(scdt_daemon_prepare(d) == 0, "prepare");
+  char token_file[200];
+  snprintf(token_file, sizeof token_file, "%s/token", d->dir);
+  ASSERT_EQ(scdt_write_file(token_file, TOKEN "\n", 0600), 0);
+  const char *args[] = {"--listen",          "tcp://127.0.0.1:0",
+                        "--token-file",      token_file,
+                        "--max-connections", max_conns,
+                        NULL};
+  if (!max_conns)
+    args[4] = NULL;
+  ASSERT_MSG(scdt_daemon_spawn(d, args, 1) == 0, "daemon did not start");
+  tcp_address(d, addr, len);
+}
+
 static void tcp_and_unix(void) {
   scdt_daemon_t d;
-  ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
-  char token_file[200], addr[64];
-  snprintf(token_file, sizeof token_file, "%s/token", d.dir);
-  ASSERT_EQ(scdt_write_file(token_file, TOKEN "\n", 0600), 0);
-  const char *args[] = {"--listen", "tcp://127.0.0.1:0", "--token-file",
-                        token_file, NULL};
-  ASSERT_MSG(scdt_daemon_spawn(&d, args, 1) == 0, "daemon did not start");
-  tcp_address(&d, addr, sizeof addr);
+  char addr[64];
+  spawn_tcp(&d, NULL, addr, sizeof addr);
 
   /* The right token: WELCOME says the field was read, and a job runs. */
   scdt_conn_t *c;
@@ -141,15 +153,8 @@ static void tcp_and_unix(void) {
  * socket, and TCP again once they leave, still serve. */
 static void silent_peers(void) {
   scdt_daemon_t d;
-  ASSERT_MSG(scdt_daemon_prepare(&d) == 0, "prepare");
-  char token_file[200], addr[64];
-  snprintf(token_file, sizeof token_file, "%s/token", d.dir);
-  ASSERT_EQ(scdt_write_file(token_file, TOKEN "\n", 0600), 0);
-  const char *args[] = {"--listen", "tcp://127.0.0.1:0", "--token-file",
-                        token_file, "--max-connections", "8",
-                        NULL};
-  ASSERT_MSG(scdt_daemon_spawn(&d, args, 1) == 0, "daemon did not start");
-  tcp_address(&d, addr, sizeof addr);
+  char addr[64];
+  spawn_tcp(&d, "8", addr, sizeof addr);
 
   /* One client in, then two silent peers: the quarter of 8. */
   scdt_conn_t *in, *quiet[2], *c;
