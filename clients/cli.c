@@ -265,18 +265,12 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
             r->params.memory_limit > 0
                 ? "; within the memory limit, a few at a time, each twice"
                 : "");
-  else if (r->params.memory_limit > 0)
+  else if (r->params.memory_limit > 0 || r->params.tiles != 1)
     fprintf(f, "Tiles: none, one triangulation: %s.\n",
-            r->params.mode == SC_MODE_COCONE ||
-                    r->params.mode == SC_MODE_SHORTCRUST
-                ? "it fits the memory limit"
-                : "this mode does not tile");
-  else if (r->params.tiles != 1)
-    fprintf(f, "Tiles: none, one triangulation: %s.\n",
-            r->params.mode == SC_MODE_BOUNDARY ||
-                    r->params.mode == SC_MODE_WATERTIGHT ||
-                    r->params.mode == SC_MODE_AUTO
+            r->params.mode != SC_MODE_COCONE &&
+                    r->params.mode != SC_MODE_SHORTCRUST
                 ? "this mode does not tile"
+            : r->params.memory_limit > 0 ? "it fits the memory limit"
             : r->params.tiles == 0 && r->params.threads == 1
                 ? "one tile per thread, and one thread"
                 : "too few points to split (2000 a tile)");
