@@ -148,6 +148,24 @@ int check_params(const sc_params_t *p, char *msg, size_t len) {
             sc_mode_name(int(as_number(p->mode))));
     return SC_EINVALID_ARGUMENT;
   }
+  if (p->tile_count > 0 && as_number(p->mode) != SC_MODE_COCONE &&
+      as_number(p->mode) != SC_MODE_SHORTCRUST) {
+    set_msg(msg, len,
+            "tile_count works in the cocone and shortcrust modes only (the "
+            "%s mode needs one triangulation of all the points)",
+            sc_mode_name(int(as_number(p->mode))));
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (p->tile_index > 0 && p->tile_count == 0) {
+    set_msg(msg, len, "tile_index needs tile_count, got tile_index %d",
+            p->tile_index);
+    return SC_EINVALID_ARGUMENT;
+  }
+  if (p->tile_count > 0 && p->tile_index >= p->tile_count) {
+    set_msg(msg, len, "tile_index must be below tile_count (%d), got %d",
+            p->tile_count, p->tile_index);
+    return SC_EINVALID_ARGUMENT;
+  }
   return SC_OK;
 }
 
@@ -257,6 +275,51 @@ extern "C" int sc_reconstruct(const double *xyz, size_t n,
     return rc;
   return guarded(msg, msg_len, [&] {
     sc::Recon r(p);
+    r.borrow(xyz, n);
+    *out = r.finish();
+    return SC_OK;
+  });
+}
+
+extern "C" int sc_reconstruct_merge(const double *xyz, size_t n,
+                                    const sc_params_t *params,
+                                    const sc_mesh_t *const *tiles, size_t count,
+                                    sc_mesh_t **out, char *msg,
+                                    size_t msg_len) {
+  if (out)
+    *out = nullptr;
+  if (!out || (!xyz && n) || !tiles) {
+    set_msg(msg, msg_len, "%s", sc_strerror(SC_EINVALID_ARGUMENT));
+    return SC_EINVALID_ARGUMENT;
+  }
+  sc_params_t p;
+  if (params)
+    p = *params;
+  else
+    sc_params_init(&p);
+  if (count < 2 || count > 4096) {
+    set_msg(msg, msg_len, "a job is split into 2 to 4096 tiles, got %zu",
+            count);
+    return SC_EINVALID_ARGUMENT;
+  }
+  for (size_t i = 0; i < count; ++i)
+    if (!tiles[i] || tiles[i]->point_count != n ||
+        (tiles[i]->triangle_count && !tiles[i]->triangles)) {
+      set_msg(msg, msg_len, "tile %zu: %s", i,
+              !tiles[i] ? "no result"
+                        : "not a result of these points (another point count)");
+      return SC_EINVALID_ARGUMENT;
+    }
+  // The job's parameters, checked as its tile jobs' were.
+  p.tile_count = int(count);
+  p.tile_index = 0;
+  int rc = sc::check_params(&p, msg, msg_len);
+  if (rc)
+    return rc;
+  p.tile_count = 0;
+  return guarded(msg, msg_len, [&] {
+    sc::Recon r(p);
+    r.merge_from(tiles, count);
     r.borrow(xyz, n);
     *out = r.finish();
     return SC_OK;

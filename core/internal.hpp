@@ -320,6 +320,25 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                   bool bounded, double margin, const sc_params_t &params,
                   Progress &progress, Filtered &out, sc_diag_t &diag,
                   double seconds[SC_STAGE_COUNT]);
+
+// One tile of a job split over several reconstructions (section 17.6): of
+// the n points split into `tiles` tiles as tiled_filter() splits them, tile
+// `index` alone, grown until it can compute the poles of its neighbours'
+// vertices too. Fills out with the distinct points' numbering, the
+// candidates the tile owns (by vertex number, in canonical order) and the
+// poles of its own vertices (zero for the others), and diag with what it
+// owns and diag.tiles. Returns false where the points cannot be split, or
+// the tile spans no volume: the job then runs on one triangulation.
+bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
+              double margin, const sc_params_t &params, Progress &progress,
+              Filtered &out, sc_diag_t &diag, double seconds[SC_STAGE_COUNT]);
+
+// The union of the results of every tile of such a job (tiles[i] by
+// tile_job(), its candidates and poles by input index): fills out as
+// tiled_filter() would. Throws SC_EINVALID_ARGUMENT for results that cannot
+// be one job's tiles.
+void merge_tiles(const double *xyz, size_t n, const sc_mesh_t *const *tiles,
+                 size_t count, Filtered &out, sc_diag_t &diag);
 } // namespace dt
 
 // Within a memory limit of `limit` bytes (section 17.5): the tiles n points
@@ -334,9 +353,18 @@ public:
   explicit Recon(const sc_params_t &p) : params_(p) {}
   void add(const double *xyz, size_t n);
   void borrow(const double *xyz, size_t n);
+  // Before borrow(): finish() takes the candidates and poles from the
+  // results of the job's tiles (sc_reconstruct_merge()).
+  void merge_from(const sc_mesh_t *const *tiles, size_t count) {
+    merge_ = tiles;
+    merge_count_ = count;
+  }
   sc_mesh_t *finish();
 
 private:
+  // A tile job's result (params.tile_count): its candidates and poles.
+  sc_mesh_t *finish_tile(const double *work, Progress &progress,
+                         sc_diag_t &diag);
   void insert_range(const double *xyz, size_t first, size_t n);
   // Watertight mode: closes surf; first cuts the handles that closed round
   // holes of the scan when `cut`.
@@ -368,6 +396,8 @@ private:
   double seconds_denoise_ = 0;
   std::unique_ptr<Triangulator> dt_;
   double seconds_[SC_STAGE_COUNT] = {};
+  const sc_mesh_t *const *merge_ = nullptr;
+  size_t merge_count_ = 0;
 };
 
 class Stopwatch {

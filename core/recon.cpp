@@ -233,14 +233,15 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
 // in chunks are inserted as they come, and inserted again, smoothed, only
 // if the estimate finds noise.)
 bool Recon::defer_insertion() const {
-  return params_.denoise != 0 || params_.memory_limit > 0 || tile_count() != 0;
+  return params_.denoise != 0 || params_.memory_limit > 0 ||
+         params_.tile_count > 0 || merge_ || tile_count() != 0;
 }
 
 // The boundary modes classify samples over the whole triangulation, and
 // run on one. Within a memory limit the number of points decides
 // (memory_tiles()), at least as many as asked for.
 size_t Recon::tile_count() const {
-  if (detects_boundary(params_.mode))
+  if (detects_boundary(params_.mode) || params_.tile_count > 0 || merge_)
     return 0;
   size_t k = params_.tiles == 1  ? 0
              : params_.tiles > 0 ? size_t(params_.tiles)
@@ -338,7 +339,7 @@ void Recon::borrow(const double *xyz, size_t n) {
   (void)tile_count();
   seconds_[SC_STAGE_INPUT] += sw.lap();
   prepare(progress);
-  if (!tile_count())
+  if (!tile_count() && params_.tile_count == 0 && !merge_)
     insert_range(work_, 0, n);
 }
 
@@ -520,11 +521,21 @@ sc_mesh_t *Recon::finish() {
   Filtered f;
   // Tiles (section 17) hold each point near their region from the start:
   // the points within a few spacings.
+  const double margin = 3 * noise_.spacing;
+  if (params_.tile_count > 0)
+    return finish_tile(work, progress, diag);
+  // The tiles of a job that ran apart, unless one of them found that the
+  // job cannot be tiled: then it runs here on one triangulation.
+  bool merged = merge_ != nullptr;
+  for (size_t i = 0; i < merge_count_; ++i)
+    merged = merged && merge_[i]->diag.tiles >= 2;
+  if (merged)
+    dt::merge_tiles(work, n_, merge_, merge_count_, f, diag);
   const bool tiled =
-      !dt_ && tile_count() &&
-      dt::tiled_filter(work, n_, tile_count(), thread_count(),
-                       params_.memory_limit > 0, 3 * noise_.spacing, params_,
-                       progress, f, diag, seconds_);
+      merged || (!dt_ && tile_count() &&
+                 dt::tiled_filter(work, n_, tile_count(), thread_count(),
+                                  params_.memory_limit > 0, margin, params_,
+                                  progress, f, diag, seconds_));
   if (!tiled) {
     f = Filtered();
     if (!dt_)
@@ -632,6 +643,30 @@ sc_mesh_t *Recon::finish() {
       out->smoothed[i] = smoothed_[i] + shift_[i % 3];
   }
   return out;
+}
+
+sc_mesh_t *Recon::finish_tile(const double *work, Progress &progress,
+                              sc_diag_t &diag) {
+  Filtered f;
+  Surface surf;
+  std::vector<double> normals(3 * n_, 0.0);
+  if (dt::tile_job(work, n_, size_t(params_.tile_count),
+                   size_t(params_.tile_index), 3 * noise_.spacing, params_,
+                   progress, f, diag, seconds_)) {
+    surf.tris.reserve(f.tris.size());
+    for (uint32_t v : f.tris)
+      surf.tris.push_back(f.to_input[v]);
+    normals = normals_by_input(f.poles, f, n_);
+  } else {
+    diag.tiles = 0; // the merge runs the job on one triangulation
+  }
+  diag.triangles = surf.tris.size() / 3;
+  for (int s = 0; s < SC_STAGE_COUNT; ++s) {
+    diag.seconds[s] = seconds_[s];
+    diag.seconds_total += seconds_[s];
+  }
+  progress.report(1.0);
+  return mesh_out(surf, normals, n_, diag);
 }
 
 } // namespace sc

@@ -190,6 +190,13 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    triangulated twice, once for its poles and once for its candidates.
  *    A job that cannot fit fails with SC_ENO_MEMORY before it allocates
  *    (docs/algorithm.md section 17.5).
+ *  - tile_count, tile_index (cocone and shortcrust modes; no command-line
+ *    option): a tile job, one part of a job whose tiles run apart, on
+ *    other machines perhaps (docs/algorithm.md section 17.6). With
+ *    tile_count k >= 2 the points are split into k tiles as `tiles` splits
+ *    them, and only tile tile_index is computed; the result is not a mesh
+ *    but what sc_reconstruct_merge() needs of that tile: see there.
+ *    tile_count 0, the default, is the whole job.
  *  - watertight_labels: 0 closes the holes with least-area patches and
  *    labels the Delaunay cells only where the patches cannot close the
  *    surface; 1 labels the cells first (inside or outside across the
@@ -231,6 +238,12 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "keep the peak memory near BYTES (a number, or with K, M, G or T: powers " \
     "of 1024) by triangulating tiles a few at a time, each twice; the same "   \
     "mesh (cocone and shortcrust modes)")                                      \
+  X(tile_count, int, INT, 0, 2, 4096, SC_RANGE_CLOSED | SC_RANGE_ZERO_DEFAULT, \
+    "in [2, 4096]", OPTION, 0, NULL, NULL,                                     \
+    "a tile job: reconstruct only tile tile_index of the job split into this " \
+    "many tiles, for sc_reconstruct_merge() (cocone and shortcrust modes)")    \
+  X(tile_index, int, INT, 0, 0, 4095, SC_RANGE_CLOSED, "in [0, 4095]", OPTION, \
+    0, NULL, NULL, "a tile job: which tile, from 0")                           \
   X(boundary_rho, double, REAL, 1.3, 0, 10,                                    \
     SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "in (0, 10]", OPTION, 0, "rho",  \
     "RHO", "boundary detection: ratio of cocone extent to pole height")        \
@@ -529,6 +542,25 @@ void sc_mesh_free(sc_mesh_t *mesh);
  */
 int sc_reconstruct(const double *xyz, size_t n, const sc_params_t *params,
                    sc_mesh_t **out, char *msg, size_t msg_len);
+
+/*
+ * A job whose tiles ran apart (params.tile_count, above), finished: tiles
+ * holds the results of the count tile jobs of these same points and
+ * parameters (tile_count = count, tile_index 0 to count - 1, in any order).
+ * A tile job's result holds, in triangles, the candidate triangles the
+ * tile decides (input indices, no orientation: not a mesh), in normals the
+ * pole of each point it owns (zero for the others), no components, and in
+ * diag what it owns, with diag.tiles the number of tiles (0 when the points
+ * cannot be tiled: the merge then reconstructs on one triangulation).
+ * params is the job's, tile_count and tile_index aside (they are ignored).
+ * The mesh is the one sc_reconstruct() gives without tiles, triangle for
+ * triangle; the normals too when every tile result carries its normals.
+ * SC_EINVALID_ARGUMENT for results that cannot be those of this job's
+ * tiles (another point count, an index out of range, a triangle twice).
+ */
+int sc_reconstruct_merge(const double *xyz, size_t n, const sc_params_t *params,
+                         const sc_mesh_t *const *tiles, size_t count,
+                         sc_mesh_t **out, char *msg, size_t msg_len);
 
 /*
  * Streaming reconstruction, for points that arrive in chunks: the Delaunay

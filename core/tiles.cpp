@@ -37,8 +37,10 @@ constexpr size_t kMinTilePoints = 2000;
 // index.
 constexpr uint8_t kSeen = 0x80;
 // CellData while the tiles are certified (the poles stage writes the
-// circumcentre over it): the cell was checked, a NaN no arithmetic gives.
+// circumcentre over it): the cell was checked, a NaN no arithmetic gives;
+// kRingChecked likewise for the second round of a tile job's (certify()).
 constexpr uint32_t kChecked = 0x7fc5a5a6u;
+constexpr uint32_t kRingChecked = 0x7fc5a5a7u;
 
 // A static k-d tree over the distinct points, by vertex number: which
 // points lie in a ball. Read by every tile's thread at once; nothing in it
@@ -547,23 +549,33 @@ std::vector<Vh> insert_foreign(const Shared &s, Tile &t,
   return made;
 }
 
-// Marks cell c checked; returns whether it was already.
-inline bool checked_before(Ch c) {
+// Marks cell c checked (the mark `sentinel`); returns whether it was
+// already.
+inline bool checked_before(Ch c, uint32_t sentinel) {
   uint32_t bits;
   std::memcpy(&bits, &c->info().cc[0], sizeof bits);
-  if (bits == kChecked)
+  if (bits == sentinel)
     return true;
-  std::memcpy(&c->info().cc[0], &kChecked, sizeof bits);
+  std::memcpy(&c->info().cc[0], &sentinel, sizeof bits);
   return false;
 }
 
+// Which cells certify() makes final: those with a vertex for which want
+// is true. Always the tile's own vertices; in a tile job also their
+// neighbours (certify()).
+struct Wanted {
+  const Ownership &own;
+  const std::vector<bool> *ring; // by vertex number, or null
+  bool operator()(uint32_t v) const { return own(v) || (ring && (*ring)[v]); }
+};
+
 // Checks finite cell c of tile t (see certify()); a point that makes it
 // wrong goes into add.
-void check_cell(const Shared &s, Tile &t, const Ownership &own, Ch c,
-                std::vector<uint32_t> &add) {
+void check_cell(const Shared &s, Tile &t, const Ownership &own,
+                const Wanted &want, Ch c, std::vector<uint32_t> &add) {
   bool mine = false;
   for (int j = 0; j < 4; ++j)
-    mine = mine || own(c->vertex(j)->info().idx);
+    mine = mine || want(c->vertex(j)->info().idx);
   if (!mine)
     return;
   double centre[3], r;
@@ -594,14 +606,14 @@ void check_cell(const Shared &s, Tile &t, const Ownership &own, Ch c,
 // only if no point lies beyond its plane (or on it, inside its circle,
 // where the perturbation decides). The point beyond nearest to the facet
 // goes into add.
-void check_hull(const Shared &s, Tile &t, const Ownership &own, Ch c,
-                std::vector<uint32_t> &add) {
+void check_hull(const Shared &s, Tile &t, const Ownership &own,
+                const Wanted &want, Ch c, std::vector<uint32_t> &add) {
   const int inf = c->index(t.dt.infinite_vertex());
   Vh fv[3];
   bool mine = false;
   for (int j = 0; j < 3; ++j) {
     fv[j] = c->vertex((inf + 1 + j) % 4);
-    mine = mine || own(fv[j]->info().idx);
+    mine = mine || want(fv[j]->info().idx);
   }
   if (!mine)
     return;
@@ -643,41 +655,62 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own, Ch c,
 // cells they make, which are all around them, are checked in the next
 // round. A certified cell stays so: no point of all is in its ball, so
 // nothing inserted later destroys it.
-void certify(const Shared &s, Tile &t, Progress &progress) {
+//
+// A tile job (tile_job()) runs alone: nothing gives it the poles of the
+// foreign vertices of the facets it tests. With `ring`, a second round
+// then certifies every cell around the neighbours of its own vertices too
+// (their neighbour sets are final once the first round is done), so that
+// the tile computes their poles itself, exactly.
+void certify(const Shared &s, Tile &t, Progress &progress, bool ring = false) {
   const Ownership own{s.owner, t.id};
   std::vector<uint32_t> add;
-  size_t cells = t.dt.number_of_cells(), k = 0;
-  for_cells(t.dt, false, [&](Ch c) {
-    progress.tick(k++, cells);
-    if (!checked_before(c))
-      check_cell(s, t, own, c, add);
-  });
-  {
-    std::vector<Ch> hull;
-    t.dt.incident_cells(t.dt.infinite_vertex(), std::back_inserter(hull));
-    for (Ch c : hull)
-      if (!checked_before(c))
-        check_hull(s, t, own, c, add);
-  }
   std::vector<Ch> around;
-  while (!add.empty()) {
-    std::sort(add.begin(), add.end());
-    add.erase(std::unique(add.begin(), add.end()), add.end());
-    const std::vector<Vh> made = insert_foreign(s, t, add, progress);
-    add.clear();
-    for (Vh v : made) {
-      around.clear();
-      t.dt.incident_cells(v, std::back_inserter(around));
-      for (Ch c : around) {
-        if (checked_before(c))
-          continue;
-        if (t.dt.is_infinite(c))
-          check_hull(s, t, own, c, add);
-        else
-          check_cell(s, t, own, c, add);
+  auto round = [&](const Wanted &want, uint32_t sentinel) {
+    size_t cells = t.dt.number_of_cells(), k = 0;
+    for_cells(t.dt, false, [&](Ch c) {
+      progress.tick(k++, cells);
+      if (!checked_before(c, sentinel))
+        check_cell(s, t, own, want, c, add);
+    });
+    {
+      std::vector<Ch> hull;
+      t.dt.incident_cells(t.dt.infinite_vertex(), std::back_inserter(hull));
+      for (Ch c : hull)
+        if (!checked_before(c, sentinel))
+          check_hull(s, t, own, want, c, add);
+    }
+    while (!add.empty()) {
+      std::sort(add.begin(), add.end());
+      add.erase(std::unique(add.begin(), add.end()), add.end());
+      const std::vector<Vh> made = insert_foreign(s, t, add, progress);
+      add.clear();
+      for (Vh v : made) {
+        around.clear();
+        t.dt.incident_cells(v, std::back_inserter(around));
+        for (Ch c : around) {
+          if (checked_before(c, sentinel))
+            continue;
+          if (t.dt.is_infinite(c))
+            check_hull(s, t, own, want, c, add);
+          else
+            check_cell(s, t, own, want, c, add);
+        }
       }
     }
-  }
+  };
+  round(Wanted{own, nullptr}, kChecked);
+  if (!ring)
+    return;
+  std::vector<bool> near(t.member.size(), false);
+  for_cells(t.dt, false, [&](Ch c) {
+    bool mine = false;
+    for (int j = 0; j < 4; ++j)
+      mine = mine || own(c->vertex(j)->info().idx);
+    if (mine)
+      for (int j = 0; j < 4; ++j)
+        near[c->vertex(j)->info().idx] = true;
+  });
+  round(Wanted{own, &near}, kRingChecked);
 }
 
 } // namespace
@@ -755,6 +788,91 @@ size_t memory_tiles(size_t n, unsigned threads, double limit) {
 
 namespace dt {
 
+namespace {
+
+// The tiles of the n points: split by counts into at most `tiles`, each
+// with its reach, its region grown by margin.
+std::vector<Tile> make_tiles(const double *xyz, size_t n, size_t tiles,
+                             double margin) {
+  std::vector<Tile> ts;
+  std::vector<uint32_t> idx(n);
+  std::iota(idx.begin(), idx.end(), 0u);
+  Box all;
+  for (int a = 0; a < 3; ++a)
+    all.lo[a] = -HUGE_VAL, all.hi[a] = HUGE_VAL;
+  ts.reserve(tiles);
+  split(xyz, idx, 0, n, tiles, all, ts);
+  for (size_t i = 0; i < ts.size(); ++i) {
+    ts[i].id = uint16_t(i);
+    for (int a = 0; a < 3; ++a)
+      ts[i].reach.lo[a] = ts[i].region.lo[a] - margin,
+      ts[i].reach.hi[a] = ts[i].region.hi[a] + margin;
+  }
+  return ts;
+}
+
+// The vertex numbering of the single triangulation (its Hilbert order of
+// all the points, the first of equal points standing for them), from
+// is_vertex (freed): out.to_input; rank (input index to vertex number,
+// UINT32_MAX for a duplicate), the distinct points by vertex number and
+// the tile that owns each, when ts is not null.
+void number_points(const double *xyz, size_t n, std::vector<uint8_t> &is_vertex,
+                   const std::vector<Tile> *ts, Filtered &out,
+                   std::vector<uint32_t> &rank, std::vector<double> &pts,
+                   std::vector<uint16_t> &owner) {
+  {
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    hilbert_sort(xyz, order);
+    out.to_input.clear();
+    for (uint32_t i : order)
+      if (is_vertex[i])
+        out.to_input.push_back(i);
+  }
+  is_vertex = {};
+  const size_t m = out.to_input.size();
+  rank.assign(n, UINT32_MAX);
+  for (size_t v = 0; v < m; ++v)
+    rank[out.to_input[v]] = uint32_t(v);
+  if (!ts)
+    return;
+  pts.resize(3 * m);
+  owner.resize(m);
+  std::vector<uint16_t> tile_of(n);
+  for (const Tile &t : *ts)
+    for (uint32_t i : t.own)
+      tile_of[i] = t.id;
+  for (size_t v = 0; v < m; ++v) {
+    const uint32_t i = out.to_input[v];
+    owner[v] = tile_of[i];
+    std::memcpy(&pts[3 * v], xyz + 3 * size_t(i), 3 * sizeof(double));
+  }
+}
+
+// A tile's own vertices, by vertex number, ascending; t.own freed.
+std::vector<uint32_t> own_vertices(Tile &t, const std::vector<uint32_t> &rank) {
+  std::vector<uint32_t> mine;
+  mine.reserve(t.own.size());
+  for (uint32_t i : t.own)
+    if (rank[i] != UINT32_MAX)
+      mine.push_back(rank[i]);
+  t.own = {};
+  std::sort(mine.begin(), mine.end());
+  return mine;
+}
+
+// The foreign points in t's reach, by vertex number, ascending.
+std::vector<uint32_t> in_reach(const Tile &t, const std::vector<double> &pts,
+                               const std::vector<uint16_t> &owner) {
+  std::vector<uint32_t> add;
+  for (size_t v = 0; v < owner.size(); ++v)
+    if (owner[v] != t.id && in_box(t.reach, &pts[3 * v]))
+      add.push_back(uint32_t(v));
+  return add;
+}
+
+} // namespace
+
 // See internal.hpp.
 bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                   bool bounded, double margin, const sc_params_t &params,
@@ -762,25 +880,10 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                   double seconds[SC_STAGE_COUNT]) {
   Stopwatch sw;
   progress.stage(SC_STAGE_DELAUNAY);
-  std::vector<Tile> ts;
-  {
-    std::vector<uint32_t> idx(n);
-    std::iota(idx.begin(), idx.end(), 0u);
-    Box all;
-    for (int a = 0; a < 3; ++a)
-      all.lo[a] = -HUGE_VAL, all.hi[a] = HUGE_VAL;
-    ts.reserve(tiles);
-    split(xyz, idx, 0, n, tiles, all, ts);
-  }
+  std::vector<Tile> ts = make_tiles(xyz, n, tiles, margin);
   if (ts.size() < 2)
     return false;
   const size_t k = ts.size();
-  for (size_t i = 0; i < k; ++i) {
-    ts[i].id = uint16_t(i);
-    for (int a = 0; a < 3; ++a)
-      ts[i].reach.lo[a] = ts[i].region.lo[a] - margin,
-      ts[i].reach.hi[a] = ts[i].region.hi[a] + margin;
-  }
 
   // Phase 1: each tile's own points, which also tell the distinct points.
   // Within a memory limit no triangulation is kept between phases: a sort
@@ -800,36 +903,12 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
     }
   }
   diag.duplicates_merged = out.dups.size();
-
-  // The vertex numbering of the single triangulation (its Hilbert order of
-  // all the points, the first of equal points standing for them).
-  {
-    std::vector<uint32_t> order(n);
-    std::iota(order.begin(), order.end(), 0u);
-    hilbert_sort(xyz, order);
-    out.to_input.clear();
-    for (uint32_t i : order)
-      if (is_vertex[i])
-        out.to_input.push_back(i);
-  }
-  is_vertex = {};
+  std::vector<uint32_t> rank;
+  std::vector<double> pts;
+  std::vector<uint16_t> owner;
+  number_points(xyz, n, is_vertex, &ts, out, rank, pts, owner);
   const size_t m = out.to_input.size();
   diag.delaunay_vertices = m;
-  std::vector<uint32_t> rank(n, UINT32_MAX);
-  std::vector<double> pts(3 * m);
-  std::vector<uint16_t> owner(m);
-  {
-    std::vector<uint16_t> tile_of(n);
-    for (Tile &t : ts)
-      for (uint32_t i : t.own)
-        tile_of[i] = t.id;
-    for (size_t v = 0; v < m; ++v) {
-      const uint32_t i = out.to_input[v];
-      rank[i] = uint32_t(v);
-      owner[v] = tile_of[i];
-      std::memcpy(&pts[3 * v], xyz + 3 * size_t(i), 3 * sizeof(double));
-    }
-  }
 
   const PointTree tree(pts.data(), m);
   const Shared shared{pts.data(), owner.data(), &tree};
@@ -840,25 +919,14 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
   std::atomic<int> flat{0};
   auto grow = [&](Tile &t, Progress &p) {
     if (bounded) {
-      std::vector<uint32_t> mine;
-      mine.reserve(t.own.size());
-      for (uint32_t i : t.own)
-        if (rank[i] != UINT32_MAX)
-          mine.push_back(rank[i]);
-      t.own = {};
-      std::sort(mine.begin(), mine.end());
-      triangulate_vertices(pts.data(), mine, t, p);
+      triangulate_vertices(pts.data(), own_vertices(t, rank), t, p);
     } else {
       for (auto v = t.dt.finite_vertices_begin();
            v != t.dt.finite_vertices_end(); ++v)
         v->info() = VertexData(rank[v->info().idx]);
     }
     t.member.assign(m, false);
-    std::vector<uint32_t> add;
-    for (size_t v = 0; v < m; ++v)
-      if (owner[v] != t.id && in_box(t.reach, &pts[3 * v]))
-        add.push_back(uint32_t(v));
-    (void)insert_foreign(shared, t, add, p);
+    (void)insert_foreign(shared, t, in_reach(t, pts, owner), p);
     if (t.dt.dimension() < 3) {
       flat = 1;
       return false;
@@ -960,6 +1028,132 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
   canonical_order(out.tris, false);
   seconds[SC_STAGE_CANDIDATES] += sw.lap();
   return true;
+}
+
+// See internal.hpp.
+bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
+              double margin, const sc_params_t &params, Progress &progress,
+              Filtered &out, sc_diag_t &diag, double seconds[SC_STAGE_COUNT]) {
+  Stopwatch sw;
+  progress.stage(SC_STAGE_DELAUNAY);
+  std::vector<Tile> ts = make_tiles(xyz, n, tiles, margin);
+  if (ts.size() < 2)
+    return false;
+  std::vector<uint8_t> is_vertex(n, 0);
+  distinct_points(xyz, n, is_vertex, out.dups);
+  diag.duplicates_merged = out.dups.size();
+  std::vector<uint32_t> rank;
+  std::vector<double> pts;
+  std::vector<uint16_t> owner;
+  number_points(xyz, n, is_vertex, &ts, out, rank, pts, owner);
+  const size_t m = out.to_input.size();
+  diag.delaunay_vertices = m;
+  diag.tiles = ts.size();
+  out.poles.assign(3 * m, 0.0);
+  // Fewer tiles than asked (too few points to split so far): the tiles
+  // past the last own nothing.
+  if (index >= ts.size())
+    return true;
+  Tile &t = ts[index];
+  std::vector<uint32_t> mine = own_vertices(t, rank);
+  for (Tile &other : ts)
+    other.own = {};
+  rank = {};
+  const PointTree tree(pts.data(), m);
+  const Shared shared{pts.data(), owner.data(), &tree};
+  triangulate_vertices(pts.data(), mine, t, progress);
+  mine = {};
+  t.member.assign(m, false);
+  (void)insert_foreign(shared, t, in_reach(t, pts, owner), progress);
+  if (t.dt.dimension() < 3)
+    return false;
+  certify(shared, t, progress, true);
+  seconds[SC_STAGE_DELAUNAY] += sw.lap();
+
+  progress.stage(SC_STAGE_POLES);
+  const Ownership own{owner.data(), t.id};
+  compute_poles(t.dt, t.infinite, progress, t.diag, &own);
+  for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
+       ++v)
+    if (own(v->info().idx))
+      std::memcpy(&out.poles[3 * size_t(v->info().idx)], v->info().pole,
+                  sizeof v->info().pole);
+  seconds[SC_STAGE_POLES] += sw.lap();
+
+  progress.stage(SC_STAGE_CANDIDATES);
+  select_candidates(t.dt, t.infinite, params, progress, out.tris, t.diag, &own);
+  canonical_order(out.tris, false);
+  diag.delaunay_cells = t.diag.delaunay_cells;
+  diag.delaunay_facets = t.diag.delaunay_facets;
+  diag.hull_facets = t.diag.hull_facets;
+  diag.hull_vertices = t.diag.hull_vertices;
+  diag.degenerate_cells = t.diag.degenerate_cells;
+  diag.tile_points_foreign = t.foreign;
+  diag.candidates = out.tris.size() / 3;
+  seconds[SC_STAGE_CANDIDATES] += sw.lap();
+  return true;
+}
+
+// See internal.hpp.
+void merge_tiles(const double *xyz, size_t n, const sc_mesh_t *const *tiles,
+                 size_t count, Filtered &out, sc_diag_t &diag) {
+  std::vector<uint8_t> is_vertex(n, 0);
+  distinct_points(xyz, n, is_vertex, out.dups);
+  diag.duplicates_merged = out.dups.size();
+  std::vector<uint32_t> rank;
+  std::vector<double> unused_pts;
+  std::vector<uint16_t> unused_owner;
+  number_points(xyz, n, is_vertex, nullptr, out, rank, unused_pts,
+                unused_owner);
+  const size_t m = out.to_input.size();
+  diag.delaunay_vertices = m;
+  out.poles.assign(3 * m, 0.0);
+  size_t total = 0;
+  for (size_t i = 0; i < count; ++i)
+    total += 3 * tiles[i]->triangle_count;
+  out.tris.reserve(total);
+  char buf[200];
+  for (size_t i = 0; i < count; ++i) {
+    const sc_mesh_t &t = *tiles[i];
+    for (size_t k = 0; k < 3 * t.triangle_count; ++k) {
+      const uint32_t x = t.triangles[k];
+      if (x >= n || rank[x] == UINT32_MAX) {
+        std::snprintf(buf, sizeof buf,
+                      "tile %zu: triangle %zu has index %u, %s", i, k / 3,
+                      unsigned(x),
+                      x >= n ? "past the last point"
+                             : "a repeated point, which is no vertex");
+        throw Error(SC_EINVALID_ARGUMENT, buf);
+      }
+      out.tris.push_back(rank[x]);
+    }
+    // Each tile sends the poles of the points it owns, zero for the others.
+    if (t.normals)
+      for (size_t v = 0; v < m; ++v) {
+        const double *p = t.normals + 3 * size_t(out.to_input[v]);
+        if (p[0] != 0 || p[1] != 0 || p[2] != 0)
+          std::memcpy(&out.poles[3 * v], p, 3 * sizeof(double));
+      }
+    diag.delaunay_cells += t.diag.delaunay_cells;
+    diag.delaunay_facets += t.diag.delaunay_facets;
+    diag.hull_facets += t.diag.hull_facets;
+    diag.hull_vertices += t.diag.hull_vertices;
+    diag.degenerate_cells += t.diag.degenerate_cells;
+    diag.tile_points_foreign += t.diag.tile_points_foreign;
+    diag.tiles = std::max<uint64_t>(diag.tiles, t.diag.tiles);
+  }
+  canonical_order(out.tris, false);
+  for (size_t k = 3; k < out.tris.size(); k += 3)
+    if (std::equal(&out.tris[k - 3], &out.tris[k], &out.tris[k])) {
+      std::snprintf(buf, sizeof buf,
+                    "two tiles give the triangle %u %u %u: the results are "
+                    "not of one job's tiles",
+                    unsigned(out.to_input[out.tris[k]]),
+                    unsigned(out.to_input[out.tris[k + 1]]),
+                    unsigned(out.to_input[out.tris[k + 2]]));
+      throw Error(SC_EINVALID_ARGUMENT, buf);
+    }
+  diag.candidates = out.tris.size() / 3;
 }
 
 } // namespace dt

@@ -4,7 +4,10 @@
  * counts of one triangulation, in the cocone and shortcrust modes, on a
  * synthetic sample, a real scan, a grid (cospherical everywhere, flat hull
  * faces) and a very uneven density; a cancel during the tiles stops them
- * all; the modes that run one triangulation say so (tiles 0).
+ * all; the modes that run one triangulation say so (tiles 0). Each tile
+ * run as a job of its own (tile_count, tile_index) and merged
+ * (sc_reconstruct_merge()) gives the same, and results that cannot be one
+ * job's tiles are refused.
  *
  *   test_core_tiles [SCAN.ply ...]
  *   test_core_tiles --quick      (a small torus on two threads, and the
@@ -75,6 +78,39 @@ static void same(const char *what, const sc_mesh_t *a, const sc_mesh_t *b,
              (double)b->diag.delaunay_vertices);
 }
 
+/* The job split into k tile jobs, each run alone as on another machine,
+ * and merged (sc_reconstruct_merge()); tile jobs in reverse order. */
+static sc_mesh_t *run_apart(const char *what, const double *xyz, size_t n,
+                            sc_mode_t mode, int k) {
+  sc_mesh_t *parts[16] = {NULL};
+  sc_params_t p;
+  sc_params_init(&p);
+  p.mode = mode;
+  p.tile_count = k;
+  char msg[256] = "";
+  int ok = 1;
+  for (int i = k - 1; i >= 0; --i) {
+    p.tile_index = i;
+    int rc = sc_reconstruct(xyz, n, &p, &parts[i], msg, sizeof msg);
+    if (rc != 0) {
+      EXPECT_FAIL("%s, %s, tile %d of %d: %s: %s", what, sc_mode_name(mode), i,
+                  k, sc_err_name(rc), msg);
+      ok = 0;
+    }
+  }
+  sc_mesh_t *mesh = NULL;
+  if (ok) {
+    int rc = sc_reconstruct_merge(xyz, n, &p, (const sc_mesh_t *const *)parts,
+                                  (size_t)k, &mesh, msg, sizeof msg);
+    if (rc != 0)
+      EXPECT_FAIL("%s, %s, %d tiles merged: %s: %s", what, sc_mode_name(mode),
+                  k, sc_err_name(rc), msg);
+  }
+  for (int i = 0; i < k; ++i)
+    sc_mesh_free(parts[i]);
+  return mesh;
+}
+
 static void check(const char *what, const double *xyz, size_t n) {
   const sc_mode_t modes[] = {SC_MODE_COCONE, SC_MODE_SHORTCRUST};
   const int tiles[][2] = {{2, 1}, {3, 2}, {5, 1}, {16, 2}};
@@ -87,6 +123,15 @@ static void check(const char *what, const double *xyz, size_t n) {
       sc_mesh_t *t = run(what, xyz, n, modes[m], tiles[k][0], tiles[k][1]);
       if (t)
         same(what, one, t, tiles[k][0], tiles[k][1]);
+      sc_mesh_free(t);
+    }
+    const int apart[] = {2, 5};
+    for (size_t k = 0; k < 2; ++k) {
+      char tag[160];
+      snprintf(tag, sizeof tag, "%s, tile jobs merged", what);
+      sc_mesh_t *t = run_apart(what, xyz, n, modes[m], apart[k]);
+      if (t)
+        same(tag, one, t, apart[k], 1);
       sc_mesh_free(t);
     }
     sc_mesh_free(one);
@@ -220,6 +265,73 @@ cancel : {
     EXPECT_EQ(sc_reconstruct(xyz, n, &p, &t, msg, sizeof msg),
               SC_EINVALID_ARGUMENT);
     EXPECT_NULL(t);
+  }
+
+  /* Tile jobs: what cannot be one job's tiles is refused, and so are tile
+   * jobs the parameters do not allow. */
+  {
+    sc_params_t p;
+    sc_params_init(&p);
+    char msg[256] = "";
+    p.tile_count = 3;
+    p.tile_index = 3;
+    EXPECT_EQ(sc_params_check(&p, msg, sizeof msg), SC_EINVALID_ARGUMENT);
+    EXPECT_NOT_NULL(strstr(msg, "tile_index must be below tile_count"));
+    p.tile_count = 0;
+    p.tile_index = 1;
+    EXPECT_EQ(sc_params_check(&p, msg, sizeof msg), SC_EINVALID_ARGUMENT);
+    EXPECT_NOT_NULL(strstr(msg, "tile_index needs tile_count"));
+    p.tile_count = 1;
+    p.tile_index = 0;
+    EXPECT_EQ(sc_params_check(&p, msg, sizeof msg), SC_EINVALID_ARGUMENT);
+    p.tile_count = 2;
+    p.mode = SC_MODE_WATERTIGHT;
+    EXPECT_EQ(sc_params_check(&p, msg, sizeof msg), SC_EINVALID_ARGUMENT);
+    EXPECT_NOT_NULL(strstr(msg, "cocone and shortcrust modes only"));
+    p.mode = SC_MODE_COCONE;
+    sc_mesh_t *parts[2] = {NULL, NULL}, *m = NULL;
+    for (int i = 0; i < 2; ++i) {
+      p.tile_index = i;
+      EXPECT_EQ(sc_reconstruct(xyz, n, &p, &parts[i], msg, sizeof msg), SC_OK);
+    }
+    if (parts[0] && parts[1]) {
+      EXPECT_EQ(parts[0]->diag.tiles, 2);
+      EXPECT_EQ(parts[0]->component_count, 0);
+      EXPECT_GT(parts[0]->triangle_count, 0);
+      EXPECT_GT(parts[1]->triangle_count, 0);
+      /* Another count of results, the same tile twice, another point
+       * count, an index past the points. */
+      const sc_mesh_t *one[1] = {parts[0]};
+      EXPECT_EQ(sc_reconstruct_merge(xyz, n, &p, one, 1, &m, msg, sizeof msg),
+                SC_EINVALID_ARGUMENT);
+      EXPECT_NULL(m);
+      const sc_mesh_t *twice[2] = {parts[0], parts[0]};
+      EXPECT_EQ(sc_reconstruct_merge(xyz, n, &p, twice, 2, &m, msg, sizeof msg),
+                SC_EINVALID_ARGUMENT);
+      EXPECT_NOT_NULL(strstr(msg, "two tiles give the triangle"));
+      const sc_mesh_t *both[2] = {parts[1], parts[0]};
+      EXPECT_EQ(
+          sc_reconstruct_merge(xyz, n - 1, &p, both, 2, &m, msg, sizeof msg),
+          SC_EINVALID_ARGUMENT);
+      EXPECT_NOT_NULL(strstr(msg, "another point count"));
+      const uint32_t keep = parts[1]->triangles[4];
+      parts[1]->triangles[4] = (uint32_t)n;
+      EXPECT_EQ(sc_reconstruct_merge(xyz, n, &p, both, 2, &m, msg, sizeof msg),
+                SC_EINVALID_ARGUMENT);
+      EXPECT_NOT_NULL(strstr(msg, "past the last point"));
+      printf("ok: a broken tile result refused: %s\n", msg);
+      parts[1]->triangles[4] = keep;
+      /* In any order, the untiled mesh. */
+      EXPECT_EQ(sc_reconstruct_merge(xyz, n, &p, both, 2, &m, msg, sizeof msg),
+                SC_OK);
+      sc_mesh_t *ref = run("torus", xyz, n, SC_MODE_COCONE, 1, 1);
+      if (m && ref)
+        same("torus, two tile jobs merged in reverse", ref, m, 2, 1);
+      sc_mesh_free(ref);
+      sc_mesh_free(m);
+    }
+    sc_mesh_free(parts[0]);
+    sc_mesh_free(parts[1]);
   }
 
   /* The boundary modes run one triangulation whatever the tiles. */
