@@ -262,7 +262,8 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
             d->delaunay_vertices ? 100.0 * (double)d->tile_points_foreign /
                                        (double)d->delaunay_vertices
                                  : 0.0,
-            r->params.memory_limit > 0
+            r->tile_jobs ? "; each a job of the daemons, merged here"
+            : r->params.memory_limit > 0
                 ? "; within the memory limit, a few at a time, each twice"
                 : "");
   else if (r->params.memory_limit > 0 || r->params.tiles != 1)

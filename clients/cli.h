@@ -126,6 +126,7 @@ typedef struct sc_cli_result {
   double seconds_read;
   double seconds_write;
   double seconds_transfer; /* time on the wire for submit; 0 otherwise */
+  int tile_jobs; /* submit --tiles: the tiles ran as jobs of the daemons */
 } sc_cli_result_t;
 
 /* The closing paragraph: points, duplicates, triangles, closed or not,

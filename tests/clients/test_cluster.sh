@@ -5,8 +5,10 @@
 # verified load run through the front with one daemon SIGKILLed in the
 # middle, which still completes every job, with retries; HAProxy's own
 # health check marking that daemon down and, once it is back on its port,
-# up again; and a daemon stopped with SIGTERM during a run, drained without
-# losing a job. Skips (77) without haproxy. Every process is stopped by its
+# up again; a daemon stopped with SIGTERM during a run, drained without
+# losing a job; one job split into tile jobs over the daemons (submit
+# --tiles), the same mesh as the local command's, also when a daemon dies
+# under it. Skips (77) without haproxy. Every process is stopped by its
 # PID.
 #   test_cluster.sh BIN_DIR TEMPLATE
 # SPDX-License-Identifier: GPL-3.0-or-later
@@ -91,6 +93,24 @@ for i in 1 2 3; do refused=$((refused + $(stat_of "$i" auth_refused_total))); do
 # The health checks pass: none of them was refused.
 wait_log "is DOWN" 20 && fail "a daemon was marked down: $(grep DOWN "$cl_dir/haproxy.log")"
 
+# One job split into tile jobs through the front (submit --tiles): spread
+# over the daemons, and the same file as the local command's.
+scan=$(dirname "$0")/../data/bunny_points.ply
+"$sc" reconstruct "$scan" -o "$cl_dir/local.ply" -q || fail "reconstruct $scan"
+for i in 1 2 3; do done_before[$i]=$(stat_of "$i" jobs_done_total); done
+"$sc" submit "$scan" -o "$cl_dir/tiles.ply" --connect "$cl_front" --token-file "$tok" \
+  --tiles 4 -q 2>"$cl_dir/err" || fail "submit --tiles 4 through the front: $(cat "$cl_dir/err")"
+cmp -s "$cl_dir/local.ply" "$cl_dir/tiles.ply" ||
+  fail "submit --tiles 4 through the front differs from reconstruct"
+served=0 total=0
+for i in 1 2 3; do
+  d=$(($(stat_of "$i" jobs_done_total) - done_before[$i]))
+  total=$((total + d))
+  [ "$d" -gt 0 ] && served=$((served + 1))
+done
+[ "$total" -eq 4 ] || fail "the daemons did $total jobs for 4 tiles"
+[ "$served" -ge 2 ] || fail "the 4 tile jobs went to $served daemon(s), want 2 or more"
+
 # A load run through the front; daemon 2 dies in the middle of it.
 jobs=150
 "$bin/shortcrust-load" --connect "$cl_front" --token-file "$tok" --clients 6 \
@@ -133,6 +153,20 @@ wait_log "d3 is DOWN" 150 || fail "HAProxy did not mark daemon 3 down"
 wait "$load" || fail "the run with a draining daemon: $(cat "$cl_dir/load3.out")"
 tail -n 1 "$cl_dir/load3.out" | grep -q '"jobs_done": 90, "errors": 0,' ||
   fail "draining: $(tail -n 1 "$cl_dir/load3.out")"
+
+# Daemon 1 dies while the tile jobs of one job run: its tiles run again
+# on daemon 2, and the mesh is still the local command's.
+before=$(stat_of 1 jobs_done_total)
+"$sc" submit "$scan" -o "$cl_dir/tiles2.ply" --connect "$cl_front" --token-file "$tok" \
+  --tiles 12 --connections 2 -q 2>"$cl_dir/tiles2.err" &
+tiles=$!
+wait_jobs 1 $((before + 1)) || fail "daemon 1 did no tile job"
+cluster_kill_daemon 1 KILL
+wait "$tiles" || fail "submit --tiles with a daemon killed: $(cat "$cl_dir/tiles2.err")"
+cmp -s "$cl_dir/local.ply" "$cl_dir/tiles2.ply" ||
+  fail "submit --tiles with a daemon killed differs from reconstruct"
+grep -q "submitted again" "$cl_dir/tiles2.err" ||
+  fail "no tile job ran again although daemon 1 died: $(cat "$cl_dir/tiles2.err")"
 
 [ "$fails" -eq 0 ] || { echo "$fails check(s) failed" >&2; exit 1; }
 echo "cluster test passed"

@@ -21,7 +21,7 @@ start_daemon "$scd" "$sc" --workers 2
 
 expect 0 "usage: shortcrust submit" "$sc" submit --help
 for opt in --output --mode --r --theta --max-hole --paper-pruning --labels --rho --alpha \
-           --denoise --denoise-scale --smoothed-vertices \
+           --denoise --denoise-scale --smoothed-vertices --tiles --connections \
            --socket --report --ascii --no-normals --quiet .las .laz; do
   grep -q -- "$opt" "$tmp/out" || fail "submit --help does not mention $opt"
 done
@@ -108,7 +108,30 @@ grep -q "property float nx" "$tmp/k.ply" && fail "--no-normals wrote normals"
 expect 0 "" "$sc" submit "$data/knot1_points.ply" -o "$tmp/q.ply" --socket "$sock" --quiet
 [ -s "$tmp/out" ] && fail "--quiet printed: $(cat "$tmp/out")"
 
+# One job split into tile jobs (--tiles), merged here: the same file, byte
+# for byte, as the local command's, normals included; too few points to
+# split run as one triangulation, and say so.
+for case in kitten_points:3:cocone bunny_points:4:shortcrust; do
+  in=${case%%:*} rest=${case#*:}
+  n=${rest%%:*} mode=${rest#*:}
+  expect 0 "Tiles: $n; .* each a job of the daemons, merged here" \
+    "$sc" submit "$data/$in.ply" -o "$tmp/t1.ply" --socket "$sock" --mode "$mode" \
+    --tiles "$n" --connections 2
+  "$sc" reconstruct "$data/$in.ply" -o "$tmp/t2.ply" --mode "$mode" -q ||
+    fail "reconstruct $in"
+  cmp -s "$tmp/t1.ply" "$tmp/t2.ply" || fail "$in in $n tile jobs differs from reconstruct"
+done
+expect 0 "Tiles: none, one triangulation: too few points to split" \
+  "$sc" submit "$tmp/tet.xyz" -o "$tmp/t1.off" --socket "$sock" --tiles 4
+grep -q "4 triangles" "$tmp/out" || fail "a tetrahedron in tiles: $(cat "$tmp/out")"
+
 # Bad command lines: status 2, before the daemon is asked anything.
+expect 2 "--tiles" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --tiles 0 --socket "$sock"
+expect 2 "--tiles" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --tiles 4097 --socket "$sock"
+expect 2 "--connections goes with --tiles" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" \
+  --connections 2 --socket "$sock"
+expect 2 "--tiles works in the cocone and shortcrust modes only" "$sc" submit \
+  "$data/knot1_points.ply" -o "$tmp/x.ply" --tiles 2 --mode boundary --socket "$sock"
 expect 2 "no input file" "$sc" submit -o "$tmp/x.ply" --socket "$sock"
 expect 2 "no output file" "$sc" submit "$data/knot1_points.ply" --socket "$sock"
 expect 2 "r must be in (0, 0.5)" "$sc" submit "$data/knot1_points.ply" -o "$tmp/x.ply" --r 0.7 --socket "$sock"
