@@ -71,14 +71,23 @@ public:
     return best;
   }
 
-  // Calls f(v) for every point v on the outer side of the plane through a
-  // with normal nrm, or within tol of it (and maybe a few more), except in
-  // parts of the tree whose box lies inside `skip`.
+  // The nearest to c of the points v on the outer side of the plane
+  // through a with normal nrm, or within tol of it (and maybe a few more),
+  // outside the box `skip`, that f(v) accepts; UINT32_MAX for none. As
+  // nearest_in_ball(): nearer parts first, and the radius shrinks to each
+  // point accepted, so that a half-space holding most of the points costs
+  // little more than an empty one.
   template <class F>
-  void beyond(const double a[3], const double nrm[3], double tol,
-              const double skip_lo[3], const double skip_hi[3], F &&f) const {
+  uint32_t nearest_beyond(const double c[3], const double a[3],
+                          const double nrm[3], double tol,
+                          const double skip_lo[3], const double skip_hi[3],
+                          F &&f) const {
+    uint32_t best = UINT32_MAX;
+    double r2 = HUGE_VAL;
     if (!nodes_.empty())
-      visit_beyond(0, a, nrm, tol, skip_lo, skip_hi, f);
+      visit_beyond(0, box_d2(nodes_[0], c), c, r2, a, nrm, tol, skip_lo,
+                   skip_hi, f, best);
+    return best;
   }
   // The length of the diagonal of the box of all the points.
   double extent() const {
@@ -101,10 +110,13 @@ private:
   }
 
   template <class F>
-  void visit_beyond(int32_t id, const double a[3], const double nrm[3],
-                    double tol, const double skip_lo[3],
-                    const double skip_hi[3], F &f) const {
+  void visit_beyond(int32_t id, double d2, const double c[3], double &r2,
+                    const double a[3], const double nrm[3], double tol,
+                    const double skip_lo[3], const double skip_hi[3], F &f,
+                    uint32_t &best) const {
     const Node &nd = nodes_[size_t(id)];
+    if (d2 > r2)
+      return;
     double top = 0;
     bool inside = true;
     for (int k = 0; k < 3; ++k) {
@@ -117,15 +129,28 @@ private:
       for (uint32_t i = nd.begin; i < nd.end; ++i) {
         const double *p = &xyz_[3 * size_t(i)];
         if (nrm[0] * (p[0] - a[0]) + nrm[1] * (p[1] - a[1]) +
-                    nrm[2] * (p[2] - a[2]) >=
-                -tol &&
-            !in_skip(p, skip_lo, skip_hi))
-          f(idx_[i]);
+                    nrm[2] * (p[2] - a[2]) <
+                -tol ||
+            in_skip(p, skip_lo, skip_hi))
+          continue;
+        const double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
+        const double e2 = dx * dx + dy * dy + dz * dz;
+        if (e2 <= r2 && f(idx_[i])) {
+          r2 = e2;
+          best = idx_[i];
+        }
       }
       return;
     }
-    visit_beyond(nd.left, a, nrm, tol, skip_lo, skip_hi, f);
-    visit_beyond(nd.right, a, nrm, tol, skip_lo, skip_hi, f);
+    const double dl = box_d2(nodes_[size_t(nd.left)], c),
+                 dr = box_d2(nodes_[size_t(nd.right)], c);
+    if (dl <= dr) {
+      visit_beyond(nd.left, dl, c, r2, a, nrm, tol, skip_lo, skip_hi, f, best);
+      visit_beyond(nd.right, dr, c, r2, a, nrm, tol, skip_lo, skip_hi, f, best);
+    } else {
+      visit_beyond(nd.right, dr, c, r2, a, nrm, tol, skip_lo, skip_hi, f, best);
+      visit_beyond(nd.left, dl, c, r2, a, nrm, tol, skip_lo, skip_hi, f, best);
+    }
   }
   struct Node {
     double lo[3], hi[3];
@@ -627,22 +652,19 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own,
   const double a[3] = {pa.x(), pa.y(), pa.z()}, nv[3] = {nrm.x, nrm.y, nrm.z};
   const double tol = 1e-9 * std::sqrt(norm2(nrm)) * s.tree->extent();
   const V3 mid = (1.0 / 3) * (v3(pa) + v3(pb) + v3(pc));
-  uint32_t best = UINT32_MAX;
-  double best_d2 = HUGE_VAL;
-  s.tree->beyond(a, nv, tol, t.reach.lo, t.reach.hi, [&](uint32_t v) {
-    if (own(v) || t.member[v])
-      return;
-    const double *q = s.pts + 3 * size_t(v);
-    const Point pq(q[0], q[1], q[2]);
-    const CGAL::Orientation o = CGAL::orientation(pa, pb, pc, pq);
-    if (o == inner || (o == CGAL::COPLANAR &&
-                       CGAL::coplanar_side_of_bounded_circle(pa, pb, pc, pq) ==
-                           CGAL::ON_UNBOUNDED_SIDE))
-      return;
-    const double d2 = norm2(v3(pq) - mid);
-    if (d2 < best_d2)
-      best_d2 = d2, best = v;
-  });
+  const double centre[3] = {mid.x, mid.y, mid.z};
+  const uint32_t best = s.tree->nearest_beyond(
+      centre, a, nv, tol, t.reach.lo, t.reach.hi, [&](uint32_t v) {
+        if (own(v) || t.member[v])
+          return false;
+        const double *q = s.pts + 3 * size_t(v);
+        const Point pq(q[0], q[1], q[2]);
+        const CGAL::Orientation o = CGAL::orientation(pa, pb, pc, pq);
+        return !(o == inner ||
+                 (o == CGAL::COPLANAR &&
+                  CGAL::coplanar_side_of_bounded_circle(pa, pb, pc, pq) ==
+                      CGAL::ON_UNBOUNDED_SIDE));
+      });
   if (best != UINT32_MAX)
     add.push_back(best);
 }
