@@ -3,13 +3,19 @@
 # the front over 1, 2 and 3 daemons (one worker each), against the same
 # load on one daemon over a direct TCP connection and over its Unix
 # socket; and the latency of one job at a time, and of a PING, on each
-# path. Each figure is the median of ROUNDS runs.
-#   scripts/cluster-bench.sh [BUILD] [ROUNDS] [POINTS]
+# path. Each figure is the median of ROUNDS runs. With INPUT, then one job
+# of that point file split into TILES tile jobs (`shortcrust submit
+# --tiles`) through the front over 1, 2 and 3 daemons, against the local
+# command on the same file (one thread, and TILES tiles on two threads),
+# the median wall time of ROUNDS runs each, and the meshes compared.
+#   scripts/cluster-bench.sh [BUILD] [ROUNDS] [POINTS] [INPUT] [TILES]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
 rounds=${2:-3}
 points=${3:-1000}
+input=${4:-}
+tiles=${5:-4}
 bin=$build/bin
 command -v haproxy >/dev/null || {
   echo "cluster-bench: haproxy not found; scripts/setup.sh installs it" >&2
@@ -66,5 +72,43 @@ for n in 1 2 3; do
     "$(load "$cl_front" 6 240 2 jobs_per_s | fmt 1)" \
     "$(load "$cl_front" 1 60 1 latency_p50_ms | fmt 2) ms" \
     "$(ping_ms "$cl_front" | fmt 3)"
+  cluster_stop
+done
+
+[ -n "$input" ] || exit 0
+
+# wall CMD...: the median wall time of the command, in seconds.
+wall() {
+  local r t0 t1
+  for r in $(seq 1 "$rounds"); do
+    t0=$(date +%s.%N)
+    "$@" >/dev/null || { echo "cluster-bench: $* failed" >&2; exit 1; }
+    t1=$(date +%s.%N)
+    awk -v a="$t0" -v b="$t1" 'BEGIN { print b - a }'
+  done | median
+}
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", a / b }'; }
+out=$(mktemp -d "${TMPDIR:-/tmp}/shortcrust-tiles.XXXXXX")
+trap 'cluster_stop; rm -rf "$out"' EXIT
+echo
+echo "cluster-bench: one job of $input in $tiles tiles;" \
+  "load average $(cut -d' ' -f1-3 /proc/loadavg)"
+local1=$(wall "$bin/shortcrust" reconstruct "$input" -o "$out/local.ply" -q)
+local2=$(wall "$bin/shortcrust" reconstruct "$input" -o "$out/local2.ply" -q \
+  --tiles "$tiles" --threads 2)
+printf '%-36s %8s s\n' "reconstruct, 1 thread" "$(echo "$local1" | fmt 2)"
+printf '%-36s %8s s  (%s of 1 thread)\n' "reconstruct, $tiles tiles on 2 threads" \
+  "$(echo "$local2" | fmt 2)" "$(ratio "$local2" "$local1")"
+for n in 1 2 3; do
+  cluster_init "$bin" daemon/haproxy/shortcrust.cfg
+  for i in $(seq 1 "$n"); do cluster_start_daemon "$i"; done
+  cluster_start_haproxy
+  t=$(wall "$bin/shortcrust" submit "$input" -o "$out/tiles.ply" -q \
+    --connect "$cl_front" --token-file "$cl_token_file" --tiles "$tiles")
+  same=same
+  cmp -s "$out/local.ply" "$out/tiles.ply" || same=DIFFERENT
+  printf '%-36s %8s s  (%s of 1 thread; mesh %s)\n' \
+    "submit --tiles $tiles, $n daemon$([ "$n" -gt 1 ] && echo s)" \
+    "$(echo "$t" | fmt 2)" "$(ratio "$t" "$local1")" "$same"
   cluster_stop
 done
