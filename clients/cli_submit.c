@@ -558,6 +558,9 @@ int sc_cmd_submit(int argc, char **argv) {
     /* The tile jobs send no progress of their own: the line shows the
      * tiles done, then the merge's stages. */
     cp.progress = NULL;
+    /* The merge smooths the points as the tile jobs did: their smoothed
+     * positions need not travel back. */
+    cp.smoothed_vertices = 0;
     sc_mesh_t *merged = NULL;
     double seconds = 0;
     status = SC_EXIT_FAILURE;

@@ -365,6 +365,8 @@ private:
   // A tile job's result (params.tile_count): its candidates and poles.
   sc_mesh_t *finish_tile(const double *work, Progress &progress,
                          sc_diag_t &diag);
+  // out, with the smoothed points when asked for (frees out on failure).
+  sc_mesh_t *with_smoothed(sc_mesh_t *out) const;
   void insert_range(const double *xyz, size_t first, size_t n);
   // Watertight mode: closes surf; first cuts the handles that closed round
   // holes of the scan when `cut`.

@@ -629,19 +629,23 @@ sc_mesh_t *Recon::finish() {
   }
   progress.report(1.0);
 
-  sc_mesh_t *out = mesh_out(surf, normals, n_, diag);
-  if (params_.smoothed_vertices && diag.denoised) {
-    // Every point's smoothed position; a duplicate was smoothed as its
-    // first occurrence was (the same neighbours).
-    out->smoothed = static_cast<double *>(
-        std::malloc(std::max<size_t>(1, smoothed_.size()) * sizeof(double)));
-    if (!out->smoothed) {
-      sc_mesh_free(out);
-      throw std::bad_alloc();
-    }
-    for (size_t i = 0; i < smoothed_.size(); ++i)
-      out->smoothed[i] = smoothed_[i] + shift_[i % 3];
+  return with_smoothed(mesh_out(surf, normals, n_, diag));
+}
+
+// With smoothed_vertices, every point's smoothed position goes with the
+// mesh; a duplicate was smoothed as its first occurrence was (the same
+// neighbours).
+sc_mesh_t *Recon::with_smoothed(sc_mesh_t *out) const {
+  if (!params_.smoothed_vertices || !out->diag.denoised)
+    return out;
+  out->smoothed = static_cast<double *>(
+      std::malloc(std::max<size_t>(1, smoothed_.size()) * sizeof(double)));
+  if (!out->smoothed) {
+    sc_mesh_free(out);
+    throw std::bad_alloc();
   }
+  for (size_t i = 0; i < smoothed_.size(); ++i)
+    out->smoothed[i] = smoothed_[i] + shift_[i % 3];
   return out;
 }
 
@@ -666,7 +670,7 @@ sc_mesh_t *Recon::finish_tile(const double *work, Progress &progress,
     diag.seconds_total += seconds_[s];
   }
   progress.report(1.0);
-  return mesh_out(surf, normals, n_, diag);
+  return with_smoothed(mesh_out(surf, normals, n_, diag));
 }
 
 } // namespace sc

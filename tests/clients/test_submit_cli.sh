@@ -121,6 +121,15 @@ for case in kitten_points:3:cocone bunny_points:4:shortcrust; do
     fail "reconstruct $in"
   cmp -s "$tmp/t1.ply" "$tmp/t2.ply" || fail "$in in $n tile jobs differs from reconstruct"
 done
+# Denoised, the tile jobs and the merge smooth alike; the smoothed
+# positions come from the merge.
+for opt in "" --smoothed-vertices; do
+  expect 0 "" "$sc" submit "$data_noisy" -o "$tmp/t1.ply" --socket "$sock" --tiles 2 \
+    --denoise $opt -q
+  "$sc" reconstruct "$data_noisy" -o "$tmp/t2.ply" --denoise $opt -q ||
+    fail "reconstruct --denoise $opt"
+  cmp -s "$tmp/t1.ply" "$tmp/t2.ply" || fail "noisy torus in 2 tile jobs ($opt) differs"
+done
 expect 0 "Tiles: none, one triangulation: too few points to split" \
   "$sc" submit "$tmp/tet.xyz" -o "$tmp/t1.off" --socket "$sock" --tiles 4
 grep -q "4 triangles" "$tmp/out" || fail "a tetrahedron in tiles: $(cat "$tmp/out")"
