@@ -33,6 +33,7 @@ typedef struct scd_config {
   unsigned max_jobs;        /* per connection; default 16 */
   uint64_t max_points;      /* per job; default 10,000,000 */
   uint64_t memory_budget;   /* bytes; default half of the memory */
+  uint64_t tile_points;     /* --tile-points; 0 (default) never tiles */
   double grace;             /* seconds; default 30 */
   int log_level;            /* default info */
 

@@ -153,6 +153,7 @@ static void start_job(scd_conn_t *c, uint32_t id, const scp_job_begin_t *m,
     return;
   }
   t->params = *params;
+  t->declared = m->point_count;
   t->owner = j;
   j->task = t;
   j->phase = SCD_JOB_UPLOADING;

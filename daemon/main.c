@@ -84,6 +84,15 @@ static void usage(FILE *f, const scd_config_t *d) {
           "                         1024 (default: half of the memory or of "
           "the cgroup\n"
           "                         limit, here %llu)\n"
+          "  --tile-points N        a cocone or shortcrust job that announces "
+          "at least N\n"
+          "                         points gathers them all, then runs in "
+          "tiles on its\n"
+          "                         worker and on every worker idle then: the "
+          "same mesh,\n"
+          "                         sooner on scans, later on exact samples "
+          "of closed\n"
+          "                         surfaces (default 0: never)\n"
           "  --grace SECONDS        on SIGTERM or SIGINT, how long running "
           "jobs may take to\n"
           "                         finish (default %g)\n"
@@ -131,6 +140,7 @@ enum {
   OPT_MAX_JOBS,
   OPT_MAX_POINTS,
   OPT_MEMORY_BUDGET,
+  OPT_TILE_POINTS,
   OPT_GRACE,
   OPT_LOG_LEVEL,
   OPT_HELP,
@@ -149,6 +159,7 @@ static int parse_args(int argc, char **argv, scd_config_t *cfg) {
       {"max-jobs", required_argument, NULL, OPT_MAX_JOBS},
       {"max-points", required_argument, NULL, OPT_MAX_POINTS},
       {"memory-budget", required_argument, NULL, OPT_MEMORY_BUDGET},
+      {"tile-points", required_argument, NULL, OPT_TILE_POINTS},
       {"grace", required_argument, NULL, OPT_GRACE},
       {"log-level", required_argument, NULL, OPT_LOG_LEVEL},
       {"help", no_argument, NULL, OPT_HELP},
@@ -215,6 +226,11 @@ static int parse_args(int argc, char **argv, scd_config_t *cfg) {
       if (scp_bytes_parse(optarg, &cfg->memory_budget))
         return bad_value("--memory-budget", optarg,
                          "want bytes, optionally with K, M, G or T");
+      break;
+    case OPT_TILE_POINTS:
+      if (parse_u64(optarg, 0, 0xFFFFFFFEu, &v))
+        return bad_value("--tile-points", optarg, "want 0 to 4294967294");
+      cfg->tile_points = v;
       break;
     case OPT_GRACE: {
       char *end;

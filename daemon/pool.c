@@ -43,8 +43,11 @@ struct scd_pool {
   uint64_t queued;
   scd_task_t *ohead, *otail;
   unsigned busy;
+  unsigned lent; /* idle workers' cores that tiled tasks use */
   int stopping;
   uint64_t batch;
+  uint64_t tile_points;
+  uint64_t tiled;
 
   uv_async_t async;       /* the loop's; workers only call uv_async_send() */
   scd_pool_event_fn fn;
@@ -157,9 +160,20 @@ static int outbox_post(scd_pool_t *p, scd_task_t *t, unsigned ev) {
  * little of its overlap. */
 #define SCD_HOLD_NS (250u * 1000u * 1000u)
 
+/* Whether the task may run its tiles on idle workers' cores: it then waits
+ * for all of its points (tiles split them all at once). */
+static int tiles_on_idle(const scd_pool_t *p, const scd_task_t *t) {
+  return p->tile_points && t->declared >= p->tile_points &&
+         (t->params.mode == SC_MODE_COCONE ||
+          t->params.mode == SC_MODE_SHORTCRUST) &&
+         t->params.tile_count == 0;
+}
+
 static int runnable(const scd_pool_t *p, scd_task_t *t) {
   if (t->input_ended || atomic_load_explicit(&t->cancel, memory_order_relaxed))
     return 1;
+  if (tiles_on_idle(p, t))
+    return 0;
   return t->pending >= p->batch &&
          (t->started || uv_hrtime() - t->first_ns >= SCD_HOLD_NS);
 }
@@ -197,7 +211,13 @@ static int run_slice(scd_task_t *t, scd_chunk_t *chunks, uint64_t n,
     snprintf(t->msg, sizeof t->msg, "cancelled");
   }
   if (!rc && !t->recon) {
-    rc = sc_recon_new(&t->params, &t->recon);
+    /* On lent cores: one tile per thread. */
+    sc_params_t params = t->params;
+    if (t->lent) {
+      params.threads = (int)(1 + t->lent);
+      params.tiles = 0;
+    }
+    rc = sc_recon_new(&params, &t->recon);
     if (rc)
       snprintf(t->msg, sizeof t->msg, "%s", sc_strerror(rc));
   }
@@ -242,7 +262,8 @@ static void worker_main(void *arg) {
   scd_pool_t *p = arg;
   uv_mutex_lock(&p->mu);
   for (;;) {
-    while (!p->qhead && !p->stopping)
+    /* A worker whose core a tiled task uses takes nothing. */
+    while ((!p->qhead || p->busy + p->lent >= p->nthreads) && !p->stopping)
       uv_cond_wait(&p->cv, &p->mu);
     if (!p->qhead)
       break;
@@ -251,6 +272,13 @@ static void worker_main(void *arg) {
     t->state = SCD_T_RUNNING;
     t->started = 1;
     p->busy++;
+    /* Its whole input here: the workers idle now lend it their cores. */
+    if (t->input_ended && tiles_on_idle(p, t) &&
+        p->busy + p->lent < p->nthreads) {
+      t->lent = p->nthreads - p->busy - p->lent;
+      p->lent += t->lent;
+      p->tiled++;
+    }
     scd_chunk_t *chunks = t->head;
     uint64_t n = t->pending;
     int ended = t->input_ended;
@@ -265,6 +293,11 @@ static void worker_main(void *arg) {
 
     uv_mutex_lock(&p->mu);
     p->busy--;
+    if (t->lent) {
+      p->lent -= t->lent;
+      t->lent = 0;
+      uv_cond_broadcast(&p->cv);
+    }
     int wake = 0;
     if (over) {
       /* Points that came during the slice are not needed any more. */
@@ -310,7 +343,8 @@ static void on_async(uv_async_t *handle) {
 }
 
 int scd_pool_new(uv_loop_t *loop, unsigned workers, uint64_t batch,
-                 scd_pool_event_fn fn, void *arg, scd_pool_t **out) {
+                 uint64_t tile_points, scd_pool_event_fn fn, void *arg,
+                 scd_pool_t **out) {
   *out = NULL;
   if (workers == 0 || !fn)
     return UV_EINVAL;
@@ -322,6 +356,7 @@ int scd_pool_new(uv_loop_t *loop, unsigned workers, uint64_t batch,
     free(p);
     return UV_ENOMEM;
   }
+  p->tile_points = tile_points;
   p->batch = batch ? batch : 1;
   p->fn = fn;
   p->arg = arg;
@@ -454,6 +489,8 @@ void scd_pool_get_stats(scd_pool_t *p, scd_pool_stats_t *out) {
   uv_mutex_lock(&p->mu);
   out->workers = p->nthreads;
   out->busy = p->busy;
+  out->lent = p->lent;
   out->queued = p->queued;
+  out->tiled = p->tiled;
   uv_mutex_unlock(&p->mu);
 }

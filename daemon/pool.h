@@ -53,6 +53,7 @@ typedef struct scd_task scd_task_t;
 struct scd_task {
   /* Set by the loop thread before scd_pool_submit(), read-only after. */
   sc_params_t params;
+  uint64_t declared; /* points JOB_BEGIN announced, 0 for unknown */
   scd_pool_t *pool;
 
   /* Loop thread only. */
@@ -69,6 +70,7 @@ struct scd_task {
   uint64_t first_ns;  /* when the first points came */
   scd_task_t *qprev, *qnext; /* run queue */
   scd_task_t *onext;  /* outbox */
+  unsigned lent;      /* idle workers' cores its tiles run on (tile_points) */
   unsigned events;    /* SCD_EV_*; non-zero exactly while in the outbox */
   uint32_t stage;
   double fraction;
@@ -96,17 +98,25 @@ typedef void (*scd_pool_event_fn)(void *arg, scd_task_t *t, unsigned events,
 typedef struct scd_pool_stats {
   unsigned workers;
   unsigned busy;    /* workers running a slice */
+  unsigned lent;    /* idle workers whose cores a tiled job uses */
   uint64_t queued;  /* tasks waiting for a worker */
+  uint64_t tiled;   /* jobs run in tiles on lent cores, in all */
 } scd_pool_stats_t;
 
 /*
  * Starts `workers` threads. A parked task goes back to the run queue once
- * it has `batch` points pending. Returns 0 or a negative libuv error code;
- * when a thread fails to start, *out is still set (with the threads that
- * did start) and the caller closes and frees the pool as usual.
+ * it has `batch` points pending. With tile_points (0: never), a job that
+ * announced at least that many points, in a mode that tiles (cocone,
+ * shortcrust), gathers all its points first and then runs its tiles on
+ * its worker and on every worker idle at that moment (docs/algorithm.md
+ * section 17): those workers take no task until it is done. Returns 0 or a
+ * negative libuv error code; when a thread fails to start, *out is still
+ * set (with the threads that did start) and the caller closes and frees
+ * the pool as usual.
  */
 int scd_pool_new(uv_loop_t *loop, unsigned workers, uint64_t batch,
-                 scd_pool_event_fn fn, void *arg, scd_pool_t **out);
+                 uint64_t tile_points, scd_pool_event_fn fn, void *arg,
+                 scd_pool_t **out);
 /* Closes the async handle; call on the loop thread once every submitted
  * task is back, before the loop ends. */
 void scd_pool_close(scd_pool_t *p);

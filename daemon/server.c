@@ -100,6 +100,8 @@ void scd_server_free_task(scd_server_t *srv, scd_task_t *t) {
  *   slow_readers_closed_total   connections closed for not reading
  *   queue_depth                 jobs waiting for a worker
  *   workers, workers_busy       the pool, and the workers running a job
+ *   workers_lent                idle workers whose cores a job's tiles use
+ *   jobs_tiled_total            jobs run in tiles on idle workers' cores
  *   memory_jobs_bytes           memory held by jobs, as estimated for
  *                               admission (meshes at their real size)
  *   memory_budget_bytes         --memory-budget
@@ -139,6 +141,8 @@ void scd_server_stats(scd_server_t *srv, scp_buf_t *b, uint32_t tag) {
       U64("queue_depth", ps.queued),
       U64("workers", ps.workers),
       U64("workers_busy", ps.busy),
+      U64("workers_lent", ps.lent),
+      U64("jobs_tiled_total", ps.tiled),
       U64("memory_jobs_bytes", srv->budget_used),
       U64("memory_budget_bytes", srv->cfg.memory_budget),
       U64("output_queued_bytes", out_queued),
@@ -302,8 +306,8 @@ int scd_server_run(const scd_config_t *cfg) {
     rc = 1;
     goto out_loop;
   }
-  urc = scd_pool_new(srv->loop, cfg->workers, cfg->batch_points, on_task_event,
-                     srv, &srv->pool);
+  urc = scd_pool_new(srv->loop, cfg->workers, cfg->batch_points,
+                     cfg->tile_points, on_task_event, srv, &srv->pool);
   if (urc != 0) {
     scd_error("cannot start %u workers: %s", cfg->workers, uv_strerror(urc));
     scd_listen_close(srv);
