@@ -164,9 +164,10 @@ static void start_job(scd_conn_t *c, uint32_t id, const scp_job_begin_t *m,
   scd_pool_submit(srv->pool, t);
   srv->tasks_in_pool++;
   srv->n.jobs_accepted_total++;
-  scp_accepted_t a = {
-      .job_id = id,
-      .queue_position = ps.busy < ps.workers ? 0 : (uint32_t)ps.queued + 1};
+  scp_accepted_t a = {.job_id = id,
+                      .queue_position = ps.busy + ps.lent < ps.workers
+                                            ? 0
+                                            : (uint32_t)ps.queued + 1};
   scd_conn_sent(c, scp_enc_accepted(&c->out, &a));
   scd_debug("job %llu:%u accepted: mode %s, %llu points announced, %u job "
             "options",

@@ -272,8 +272,9 @@ static void worker_main(void *arg) {
     t->state = SCD_T_RUNNING;
     t->started = 1;
     p->busy++;
-    /* Its whole input here: the workers idle now lend it their cores. */
-    if (t->input_ended && tiles_on_idle(p, t) &&
+    /* Its whole input here, and no other task waiting: the workers idle
+     * now lend it their cores. */
+    if (t->input_ended && tiles_on_idle(p, t) && !p->qhead &&
         p->busy + p->lent < p->nthreads) {
       t->lent = p->nthreads - p->busy - p->lent;
       p->lent += t->lent;

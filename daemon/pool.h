@@ -107,9 +107,10 @@ typedef struct scd_pool_stats {
  * Starts `workers` threads. A parked task goes back to the run queue once
  * it has `batch` points pending. With tile_points (0: never), a job that
  * announced at least that many points, in a mode that tiles (cocone,
- * shortcrust), gathers all its points first and then runs its tiles on
- * its worker and on every worker idle at that moment (docs/algorithm.md
- * section 17): those workers take no task until it is done. Returns 0 or a
+ * shortcrust), gathers all its points first and then, when no other task
+ * waits, runs its tiles on its worker and on every worker idle at that
+ * moment (docs/algorithm.md section 17): those workers take no task until
+ * it is done. Returns 0 or a
  * negative libuv error code; when a thread fails to start, *out is still
  * set (with the threads that did start) and the caller closes and frees
  * the pool as usual.

@@ -90,7 +90,7 @@ int main(int argc, char **argv) {
   scdt_job_reset(&a);
 
   /* Two large jobs at once, one of them in the shortcrust mode: both
-   * right, whichever got the idle core. */
+   * right, whether one of them found the other worker idle or not. */
   scdt_job_t b;
   scdt_job_init(&a, 2, torus, N);
   scdt_job_init(&b, 3, torus, N);
@@ -100,7 +100,7 @@ int main(int argc, char **argv) {
   expect_same(&a, cocone, "two large jobs at once, the first");
   expect_same(&b, crust, "two large jobs at once, the second");
   const uint64_t after = tiled();
-  EXPECT_MSG(after >= 2 && after <= 3, "jobs_tiled_total %llu, want 2 or 3",
+  EXPECT_MSG(after <= 3, "jobs_tiled_total %llu, want 1 to 3",
              (unsigned long long)after);
   EXPECT_EQ(scdt_stat_fresh(d.sock, "workers_lent"), 0);
   printf("tiles on idle workers: %llu of 4 large jobs tiled\n",
