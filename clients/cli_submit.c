@@ -247,7 +247,8 @@ static int tile_copy(sc_client_job_t *job, sc_mesh_t *out) {
   out->normals = nn ? malloc(nn * sizeof *out->normals) : NULL;
   if (!out->triangles || (nn && !out->normals))
     return -1;
-  memcpy(out->triangles, m.triangles, nt * sizeof *out->triangles);
+  if (nt)
+    memcpy(out->triangles, m.triangles, nt * sizeof *out->triangles);
   if (nn)
     memcpy(out->normals, m.normals, nn * sizeof *out->normals);
   out->triangle_count = (size_t)m.triangle_count;
