@@ -2,7 +2,8 @@
  * `shortcrust submit`: read a point file, have the daemon reconstruct it,
  * write the mesh. Options, formats, summary and report are those of
  * `shortcrust reconstruct`, and so are the triangles: the points travel as
- * exact doubles and the daemon runs the same core with the same defaults.
+ * exact values (floats when every coordinate is one, doubles otherwise)
+ * and the daemon runs the same core with the same defaults.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later

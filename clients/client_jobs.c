@@ -9,6 +9,8 @@
 #include "client_internal.h"
 #include "shortcrust_files.h"
 
+#include <float.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -147,6 +149,19 @@ static sc_client_job_t *job_new(sc_client_t *c, const sc_client_params_t *p,
   return j;
 }
 
+/* Whether every coordinate is exactly a float: the points then travel as
+ * F32_XYZ, half the bytes, and the daemon gets the very same doubles
+ * back. (A non-finite coordinate is not, and goes as F64 for the daemon to
+ * refuse.) */
+static int scc_float_exact(const double *xyz, uint64_t n) {
+  for (uint64_t i = 0; i < 3 * n; i++) {
+    /* Beyond the floats' range (or NaN) a conversion is undefined. */
+    if (!(fabs(xyz[i]) <= FLT_MAX) || (double)(float)xyz[i] != xyz[i])
+      return 0;
+  }
+  return 1;
+}
+
 /* Uploads the job's points; the job is linked to the handle already. */
 static int upload(sc_client_t *c, sc_client_job_t *j, const double *xyz) {
   if (j->n > c->welcome.max_points) {
@@ -186,8 +201,10 @@ static int upload(sc_client_t *c, sc_client_job_t *j, const double *xyz) {
   c->in_use++;
   uint64_t next = 0;
   int rc = 0;
+  const uint32_t format =
+      scc_float_exact(xyz, j->n) ? SCP_F32_XYZ : SCP_F64_XYZ;
   while (next < j->n && !j->server_done && !j->cancelled) {
-    rc = scp_enc_points_next(&c->out, j->id, SCP_F64_XYZ, xyz, j->n, &next);
+    rc = scp_enc_points_next(&c->out, j->id, format, xyz, j->n, &next);
     if (rc < 0) {
       rc = scc_fail(c, SC_CLIENT_ENOMEM, "out of memory");
       break;

@@ -290,7 +290,8 @@ void sc_client_params_init(sc_client_params_t *p);
 
 /*
  * Starts a job of n points (xyz: 3n doubles) and uploads them, in chunks
- * as large as a frame allows, as exact doubles. Returns once every point
+ * as large as a frame allows, exactly: as floats (F32_XYZ) when every
+ * coordinate is exactly a float, as doubles otherwise. Returns once every point
  * is written, or earlier when the job ends before (refused, cancelled);
  * the points are not used after that. The job is then under way: wait for
  * it with sc_client_wait() or sc_client_wait_any(), and free it with

@@ -169,6 +169,22 @@ expect 0 '"jobs_done_total": ' "$sc" stats --socket "$sock" --json
 grep -q '^{"socket": ".*"connections": [0-9]*.*}$' "$tmp/out" || fail "stats --json: $(cat "$tmp/out")"
 grep -q '"jobs_failed_total": 2[,}]' "$tmp/out" || fail "stats --json: two jobs failed: $(cat "$tmp/out")"
 
+# Points that are floats travel as floats (12 bytes a point), others as
+# doubles (24): the daemon's byte count says which went.
+bytes_in() {
+  "$sc" stats --socket "$sock" --json | sed -n 's/.*"bytes_in_total": \([0-9]*\).*/\1/p'
+}
+for case in "$data/kitten_points.ply:14472:12" "$data_noisy:6000:24"; do
+  file=${case%%:*} rest=${case#*:}
+  n=${rest%%:*} size=${rest#*:}
+  before=$(bytes_in)
+  "$sc" submit "$file" -o "$tmp/x.ply" --socket "$sock" -q || fail "submit $file"
+  sent=$(($(bytes_in) - before))
+  [ "$sent" -ge $((size * n)) ] && [ "$sent" -lt $(((size + 4) * n)) ] ||
+    fail "$file: $sent bytes for $n points, want about $size a point"
+done
+rm -f "$tmp/x.ply"
+
 # Standard input and output, as for reconstruct: the same bytes as a file.
 "$sc" reconstruct "$data/knot1_points.ply" -o "$tmp/file.ply" -q || fail "reconstruct to a file"
 "$sc" submit - -o - --socket "$sock" < "$data/knot1_points.ply" > "$tmp/piped.ply" 2> "$tmp/err" ||
