@@ -256,9 +256,14 @@ extern "C" int sc_recon_finish(sc_recon_t *r, sc_mesh_t **out, char *msg,
 
 extern "C" void sc_recon_free(sc_recon_t *r) { delete r; }
 
-extern "C" int sc_reconstruct(const double *xyz, size_t n,
-                              const sc_params_t *params, sc_mesh_t **out,
-                              char *msg, size_t msg_len) {
+// The one-call reconstructions: the points, the parameters checked (once
+// `adjust` has had its say: 0, or an error with msg set), and, for a merge,
+// the results of the job's tiles.
+template <class Adjust>
+static int reconstruct(const double *xyz, size_t n, const sc_params_t *params,
+                       const sc_mesh_t *const *tiles, size_t count,
+                       sc_mesh_t **out, char *msg, size_t msg_len,
+                       Adjust &&adjust) {
   if (out)
     *out = nullptr;
   if (!out || (!xyz && n)) {
@@ -270,15 +275,29 @@ extern "C" int sc_reconstruct(const double *xyz, size_t n,
     p = *params;
   else
     sc_params_init(&p);
-  int rc = sc::check_params(&p, msg, msg_len);
+  int rc = adjust(p);
+  if (!rc)
+    rc = sc::check_params(&p, msg, msg_len);
   if (rc)
     return rc;
+  // A merge is checked as its tile jobs were, and then runs untiled.
+  if (tiles)
+    p.tile_count = 0;
   return guarded(msg, msg_len, [&] {
     sc::Recon r(p);
+    if (tiles)
+      r.merge_from(tiles, count);
     r.borrow(xyz, n);
     *out = r.finish();
     return SC_OK;
   });
+}
+
+extern "C" int sc_reconstruct(const double *xyz, size_t n,
+                              const sc_params_t *params, sc_mesh_t **out,
+                              char *msg, size_t msg_len) {
+  return reconstruct(xyz, n, params, nullptr, 0, out, msg, msg_len,
+                     [](sc_params_t &) { return SC_OK; });
 }
 
 extern "C" int sc_reconstruct_merge(const double *xyz, size_t n,
@@ -286,44 +305,33 @@ extern "C" int sc_reconstruct_merge(const double *xyz, size_t n,
                                     const sc_mesh_t *const *tiles, size_t count,
                                     sc_mesh_t **out, char *msg,
                                     size_t msg_len) {
-  if (out)
-    *out = nullptr;
-  if (!out || (!xyz && n) || !tiles) {
+  if (!tiles) {
+    if (out)
+      *out = nullptr;
     set_msg(msg, msg_len, "%s", sc_strerror(SC_EINVALID_ARGUMENT));
     return SC_EINVALID_ARGUMENT;
   }
-  sc_params_t p;
-  if (params)
-    p = *params;
-  else
-    sc_params_init(&p);
-  if (count < 2 || count > 4096) {
-    set_msg(msg, msg_len, "a job is split into 2 to 4096 tiles, got %zu",
-            count);
-    return SC_EINVALID_ARGUMENT;
-  }
-  for (size_t i = 0; i < count; ++i)
-    if (!tiles[i] || tiles[i]->point_count != n ||
-        (tiles[i]->triangle_count && !tiles[i]->triangles)) {
-      set_msg(msg, msg_len, "tile %zu: %s", i,
-              !tiles[i] ? "no result"
-                        : "not a result of these points (another point count)");
-      return SC_EINVALID_ARGUMENT;
-    }
-  // The job's parameters, checked as its tile jobs' were.
-  p.tile_count = int(count);
-  p.tile_index = 0;
-  int rc = sc::check_params(&p, msg, msg_len);
-  if (rc)
-    return rc;
-  p.tile_count = 0;
-  return guarded(msg, msg_len, [&] {
-    sc::Recon r(p);
-    r.merge_from(tiles, count);
-    r.borrow(xyz, n);
-    *out = r.finish();
-    return SC_OK;
-  });
+  return reconstruct(
+      xyz, n, params, tiles, count, out, msg, msg_len, [&](sc_params_t &p) {
+        if (count < 2 || count > 4096) {
+          set_msg(msg, msg_len, "a job is split into 2 to 4096 tiles, got %zu",
+                  count);
+          return int(SC_EINVALID_ARGUMENT);
+        }
+        for (size_t i = 0; i < count; ++i)
+          if (!tiles[i] || tiles[i]->point_count != n ||
+              (tiles[i]->triangle_count && !tiles[i]->triangles)) {
+            set_msg(msg, msg_len, "tile %zu: %s", i,
+                    !tiles[i] ? "no result"
+                              : "not a result of these points (another "
+                                "point count)");
+            return int(SC_EINVALID_ARGUMENT);
+          }
+        // The job's parameters, checked as its tile jobs' were.
+        p.tile_count = int(count);
+        p.tile_index = 0;
+        return int(SC_OK);
+      });
 }
 
 extern "C" void sc_mesh_free(sc_mesh_t *mesh) {

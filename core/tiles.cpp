@@ -833,15 +833,24 @@ std::vector<Tile> make_tiles(const double *xyz, size_t n, size_t tiles,
   return ts;
 }
 
+// The numbering of number_points(): rank, input index to vertex number
+// (UINT32_MAX for a duplicate); with tiles, the distinct points by vertex
+// number and the tile that owns each.
+struct Numbering {
+  std::vector<uint32_t> rank;
+  std::vector<double> pts;
+  std::vector<uint16_t> owner;
+};
+
 // The vertex numbering of the single triangulation (its Hilbert order of
 // all the points, the first of equal points standing for them), from
-// is_vertex (freed): out.to_input; rank (input index to vertex number,
-// UINT32_MAX for a duplicate), the distinct points by vertex number and
-// the tile that owns each, when ts is not null.
-void number_points(const double *xyz, size_t n, std::vector<uint8_t> &is_vertex,
-                   const std::vector<Tile> *ts, Filtered &out,
-                   std::vector<uint32_t> &rank, std::vector<double> &pts,
-                   std::vector<uint16_t> &owner) {
+// is_vertex (freed) and out.dups: out.to_input, and the counts of diag
+// that it gives.
+Numbering number_points(const double *xyz, size_t n,
+                        std::vector<uint8_t> &is_vertex,
+                        const std::vector<Tile> *ts, Filtered &out,
+                        sc_diag_t &diag) {
+  Numbering num;
   {
     std::vector<uint32_t> order(n);
     std::iota(order.begin(), order.end(), 0u);
@@ -853,22 +862,35 @@ void number_points(const double *xyz, size_t n, std::vector<uint8_t> &is_vertex,
   }
   is_vertex = {};
   const size_t m = out.to_input.size();
-  rank.assign(n, UINT32_MAX);
+  diag.duplicates_merged = out.dups.size();
+  diag.delaunay_vertices = m;
+  num.rank.assign(n, UINT32_MAX);
   for (size_t v = 0; v < m; ++v)
-    rank[out.to_input[v]] = uint32_t(v);
+    num.rank[out.to_input[v]] = uint32_t(v);
   if (!ts)
-    return;
-  pts.resize(3 * m);
-  owner.resize(m);
+    return num;
+  num.pts.resize(3 * m);
+  num.owner.resize(m);
   std::vector<uint16_t> tile_of(n);
   for (const Tile &t : *ts)
     for (uint32_t i : t.own)
       tile_of[i] = t.id;
   for (size_t v = 0; v < m; ++v) {
     const uint32_t i = out.to_input[v];
-    owner[v] = tile_of[i];
-    std::memcpy(&pts[3 * v], xyz + 3 * size_t(i), 3 * sizeof(double));
+    num.owner[v] = tile_of[i];
+    std::memcpy(&num.pts[3 * v], xyz + 3 * size_t(i), 3 * sizeof(double));
   }
+  return num;
+}
+
+// Adds what a tile counted of the triangulation to diag.
+void add_tile_counts(sc_diag_t &diag, const sc_diag_t &tile) {
+  diag.delaunay_cells += tile.delaunay_cells;
+  diag.delaunay_facets += tile.delaunay_facets;
+  diag.hull_facets += tile.hull_facets;
+  diag.hull_vertices += tile.hull_vertices;
+  diag.degenerate_cells += tile.degenerate_cells;
+  diag.tile_points_foreign += tile.tile_points_foreign;
 }
 
 // A tile's own vertices, by vertex number, ascending; t.own freed.
@@ -891,6 +913,33 @@ std::vector<uint32_t> in_reach(const Tile &t, const std::vector<double> &pts,
     if (owner[v] != t.id && in_box(t.reach, &pts[3 * v]))
       add.push_back(uint32_t(v));
   return add;
+}
+
+// Grows tile t, triangulated from its own points, by the foreign points in
+// its reach and then until its cells are certified (certify(); with ring,
+// one ring more). False, having certified nothing, when the tile spans no
+// volume.
+bool grow_tile(const Shared &s, Tile &t, const std::vector<double> &pts,
+               const std::vector<uint16_t> &owner, bool ring,
+               Progress &progress) {
+  t.member.assign(owner.size(), false);
+  (void)insert_foreign(s, t, in_reach(t, pts, owner), progress);
+  if (t.dt.dimension() < 3)
+    return false;
+  certify(s, t, progress, ring);
+  return true;
+}
+
+// The poles of tile t (computed, poles.cpp), its own vertices' into poles,
+// by vertex number.
+void tile_poles(Tile &t, const Ownership &own, Progress &progress,
+                sc_diag_t &diag, std::vector<double> &poles) {
+  compute_poles(t.dt, t.infinite, progress, diag, &own);
+  for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
+       ++v)
+    if (own(v->info().idx))
+      std::memcpy(&poles[3 * size_t(v->info().idx)], v->info().pole,
+                  sizeof v->info().pole);
 }
 
 } // namespace
@@ -924,13 +973,11 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
       t.dups = {};
     }
   }
-  diag.duplicates_merged = out.dups.size();
-  std::vector<uint32_t> rank;
-  std::vector<double> pts;
-  std::vector<uint16_t> owner;
-  number_points(xyz, n, is_vertex, &ts, out, rank, pts, owner);
+  const Numbering num = number_points(xyz, n, is_vertex, &ts, out, diag);
+  const std::vector<uint32_t> &rank = num.rank;
+  const std::vector<double> &pts = num.pts;
+  const std::vector<uint16_t> &owner = num.owner;
   const size_t m = out.to_input.size();
-  diag.delaunay_vertices = m;
 
   const PointTree tree(pts.data(), m);
   const Shared shared{pts.data(), owner.data(), &tree};
@@ -947,24 +994,14 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
            v != t.dt.finite_vertices_end(); ++v)
         v->info() = VertexData(rank[v->info().idx]);
     }
-    t.member.assign(m, false);
-    (void)insert_foreign(shared, t, in_reach(t, pts, owner), p);
-    if (t.dt.dimension() < 3) {
-      flat = 1;
-      return false;
-    }
-    certify(shared, t, p);
-    return true;
+    if (grow_tile(shared, t, pts, owner, false, p))
+      return true;
+    flat = 1;
+    return false;
   };
   // Phase 3: poles, each tile's own into the shared array.
   auto poles = [&](Tile &t, Progress &p, sc_diag_t &d) {
-    const Ownership own{owner.data(), t.id};
-    compute_poles(t.dt, t.infinite, p, d, &own);
-    for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
-         ++v)
-      if (own(v->info().idx))
-        std::memcpy(&out.poles[3 * size_t(v->info().idx)], v->info().pole,
-                    sizeof v->info().pole);
+    tile_poles(t, Ownership{owner.data(), t.id}, p, d, out.poles);
   };
   // A tile's triangulation and what points into it, freed.
   auto drop = [](Tile &t) {
@@ -1038,12 +1075,8 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
   for (Tile &t : ts) {
     out.tris.insert(out.tris.end(), t.tris.begin(), t.tris.end());
     t.tris = {};
-    diag.delaunay_cells += t.diag.delaunay_cells;
-    diag.delaunay_facets += t.diag.delaunay_facets;
-    diag.hull_facets += t.diag.hull_facets;
-    diag.hull_vertices += t.diag.hull_vertices;
-    diag.degenerate_cells += t.diag.degenerate_cells;
-    diag.tile_points_foreign += t.foreign;
+    t.diag.tile_points_foreign = t.foreign;
+    add_tile_counts(diag, t.diag);
   }
   diag.tiles = k;
   diag.candidates = out.tris.size() / 3;
@@ -1063,13 +1096,10 @@ bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
     return false;
   std::vector<uint8_t> is_vertex(n, 0);
   distinct_points(xyz, n, is_vertex, out.dups);
-  diag.duplicates_merged = out.dups.size();
-  std::vector<uint32_t> rank;
-  std::vector<double> pts;
-  std::vector<uint16_t> owner;
-  number_points(xyz, n, is_vertex, &ts, out, rank, pts, owner);
+  Numbering num = number_points(xyz, n, is_vertex, &ts, out, diag);
+  const std::vector<double> &pts = num.pts;
+  const std::vector<uint16_t> &owner = num.owner;
   const size_t m = out.to_input.size();
-  diag.delaunay_vertices = m;
   diag.tiles = ts.size();
   out.poles.assign(3 * m, 0.0);
   // Fewer tiles than asked (too few points to split so far): the tiles
@@ -1077,40 +1107,28 @@ bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
   if (index >= ts.size())
     return true;
   Tile &t = ts[index];
-  std::vector<uint32_t> mine = own_vertices(t, rank);
+  std::vector<uint32_t> mine = own_vertices(t, num.rank);
   for (Tile &other : ts)
     other.own = {};
-  rank = {};
+  num.rank = {};
   const PointTree tree(pts.data(), m);
   const Shared shared{pts.data(), owner.data(), &tree};
   triangulate_vertices(pts.data(), mine, t, progress);
   mine = {};
-  t.member.assign(m, false);
-  (void)insert_foreign(shared, t, in_reach(t, pts, owner), progress);
-  if (t.dt.dimension() < 3)
+  if (!grow_tile(shared, t, pts, owner, true, progress))
     return false;
-  certify(shared, t, progress, true);
   seconds[SC_STAGE_DELAUNAY] += sw.lap();
 
   progress.stage(SC_STAGE_POLES);
   const Ownership own{owner.data(), t.id};
-  compute_poles(t.dt, t.infinite, progress, t.diag, &own);
-  for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
-       ++v)
-    if (own(v->info().idx))
-      std::memcpy(&out.poles[3 * size_t(v->info().idx)], v->info().pole,
-                  sizeof v->info().pole);
+  tile_poles(t, own, progress, t.diag, out.poles);
   seconds[SC_STAGE_POLES] += sw.lap();
 
   progress.stage(SC_STAGE_CANDIDATES);
   select_candidates(t.dt, t.infinite, params, progress, out.tris, t.diag, &own);
   canonical_order(out.tris, false);
-  diag.delaunay_cells = t.diag.delaunay_cells;
-  diag.delaunay_facets = t.diag.delaunay_facets;
-  diag.hull_facets = t.diag.hull_facets;
-  diag.hull_vertices = t.diag.hull_vertices;
-  diag.degenerate_cells = t.diag.degenerate_cells;
-  diag.tile_points_foreign = t.foreign;
+  t.diag.tile_points_foreign = t.foreign;
+  add_tile_counts(diag, t.diag);
   diag.candidates = out.tris.size() / 3;
   seconds[SC_STAGE_CANDIDATES] += sw.lap();
   return true;
@@ -1121,14 +1139,9 @@ void merge_tiles(const double *xyz, size_t n, const sc_mesh_t *const *tiles,
                  size_t count, Filtered &out, sc_diag_t &diag) {
   std::vector<uint8_t> is_vertex(n, 0);
   distinct_points(xyz, n, is_vertex, out.dups);
-  diag.duplicates_merged = out.dups.size();
-  std::vector<uint32_t> rank;
-  std::vector<double> unused_pts;
-  std::vector<uint16_t> unused_owner;
-  number_points(xyz, n, is_vertex, nullptr, out, rank, unused_pts,
-                unused_owner);
+  const std::vector<uint32_t> rank =
+      number_points(xyz, n, is_vertex, nullptr, out, diag).rank;
   const size_t m = out.to_input.size();
-  diag.delaunay_vertices = m;
   out.poles.assign(3 * m, 0.0);
   size_t total = 0;
   for (size_t i = 0; i < count; ++i)
@@ -1156,12 +1169,7 @@ void merge_tiles(const double *xyz, size_t n, const sc_mesh_t *const *tiles,
         if (p[0] != 0 || p[1] != 0 || p[2] != 0)
           std::memcpy(&out.poles[3 * v], p, 3 * sizeof(double));
       }
-    diag.delaunay_cells += t.diag.delaunay_cells;
-    diag.delaunay_facets += t.diag.delaunay_facets;
-    diag.hull_facets += t.diag.hull_facets;
-    diag.hull_vertices += t.diag.hull_vertices;
-    diag.degenerate_cells += t.diag.degenerate_cells;
-    diag.tile_points_foreign += t.diag.tile_points_foreign;
+    add_tile_counts(diag, t.diag);
     diag.tiles = std::max<uint64_t>(diag.tiles, t.diag.tiles);
   }
   canonical_order(out.tris, false);
