@@ -365,8 +365,15 @@ private:
   // A tile job's result (params.tile_count): its candidates and poles.
   sc_mesh_t *finish_tile(const double *work, Progress &progress,
                          sc_diag_t &diag);
-  // out, with the smoothed points when asked for (frees out on failure).
-  sc_mesh_t *with_smoothed(sc_mesh_t *out) const;
+  // The result handed back: the stage times in diag, the progress at its
+  // end, and the smoothed points when asked for.
+  sc_mesh_t *result(const Surface &surf, const std::vector<double> &normals,
+                    sc_diag_t &diag, Progress &progress) const;
+  // A tile job, or the merge of tile jobs' results: no tiles of its own
+  // (tile_count() is 0), and every point before the work starts.
+  bool apart() const { return params_.tile_count > 0 || merge_; }
+  // How far each tile holds the points beyond its region from the start.
+  double tile_margin() const { return 3 * noise_.spacing; }
   void insert_range(const double *xyz, size_t first, size_t n);
   // Watertight mode: closes surf; first cuts the handles that closed round
   // holes of the scan when `cut`.

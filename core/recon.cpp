@@ -233,15 +233,15 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
 // in chunks are inserted as they come, and inserted again, smoothed, only
 // if the estimate finds noise.)
 bool Recon::defer_insertion() const {
-  return params_.denoise != 0 || params_.memory_limit > 0 ||
-         params_.tile_count > 0 || merge_ || tile_count() != 0;
+  return params_.denoise != 0 || params_.memory_limit > 0 || apart() ||
+         tile_count() != 0;
 }
 
 // The boundary modes classify samples over the whole triangulation, and
 // run on one. Within a memory limit the number of points decides
 // (memory_tiles()), at least as many as asked for.
 size_t Recon::tile_count() const {
-  if (detects_boundary(params_.mode) || params_.tile_count > 0 || merge_)
+  if (detects_boundary(params_.mode) || apart())
     return 0;
   size_t k = params_.tiles == 1  ? 0
              : params_.tiles > 0 ? size_t(params_.tiles)
@@ -339,7 +339,7 @@ void Recon::borrow(const double *xyz, size_t n) {
   (void)tile_count();
   seconds_[SC_STAGE_INPUT] += sw.lap();
   prepare(progress);
-  if (!tile_count() && params_.tile_count == 0 && !merge_)
+  if (!tile_count() && !apart())
     insert_range(work_, 0, n);
 }
 
@@ -519,9 +519,6 @@ sc_mesh_t *Recon::finish() {
   diag.denoise_shift = smoothing_.shift;
   diag.seconds_denoise = seconds_denoise_;
   Filtered f;
-  // Tiles (section 17) hold each point near their region from the start:
-  // the points within a few spacings.
-  const double margin = 3 * noise_.spacing;
   if (params_.tile_count > 0)
     return finish_tile(work, progress, diag);
   // The tiles of a job that ran apart, unless one of them found that the
@@ -534,8 +531,8 @@ sc_mesh_t *Recon::finish() {
   const bool tiled =
       merged || (!dt_ && tile_count() &&
                  dt::tiled_filter(work, n_, tile_count(), thread_count(),
-                                  params_.memory_limit > 0, margin, params_,
-                                  progress, f, diag, seconds_));
+                                  params_.memory_limit > 0, tile_margin(),
+                                  params_, progress, f, diag, seconds_));
   if (!tiled) {
     f = Filtered();
     if (!dt_)
@@ -622,21 +619,22 @@ sc_mesh_t *Recon::finish() {
   // caller must not take for an ordinary success: the points do not look
   // like a surface this mode can reconstruct (PROTOCOL.md 6.9).
   diag.mostly_unused = 2 * diag.samples_unused > diag.delaunay_vertices;
-
-  for (int s = 0; s < SC_STAGE_COUNT; ++s) {
-    diag.seconds[s] = seconds_[s];
-    diag.seconds_total += seconds_[s];
-  }
-  progress.report(1.0);
-
-  return with_smoothed(mesh_out(surf, normals, n_, diag));
+  return result(surf, normals, diag, progress);
 }
 
 // With smoothed_vertices, every point's smoothed position goes with the
 // mesh; a duplicate was smoothed as its first occurrence was (the same
 // neighbours).
-sc_mesh_t *Recon::with_smoothed(sc_mesh_t *out) const {
-  if (!params_.smoothed_vertices || !out->diag.denoised)
+sc_mesh_t *Recon::result(const Surface &surf,
+                         const std::vector<double> &normals, sc_diag_t &diag,
+                         Progress &progress) const {
+  for (int s = 0; s < SC_STAGE_COUNT; ++s) {
+    diag.seconds[s] = seconds_[s];
+    diag.seconds_total += seconds_[s];
+  }
+  progress.report(1.0);
+  sc_mesh_t *out = mesh_out(surf, normals, n_, diag);
+  if (!params_.smoothed_vertices || !diag.denoised)
     return out;
   out->smoothed = static_cast<double *>(
       std::malloc(std::max<size_t>(1, smoothed_.size()) * sizeof(double)));
@@ -655,8 +653,8 @@ sc_mesh_t *Recon::finish_tile(const double *work, Progress &progress,
   Surface surf;
   std::vector<double> normals(3 * n_, 0.0);
   if (dt::tile_job(work, n_, size_t(params_.tile_count),
-                   size_t(params_.tile_index), 3 * noise_.spacing, params_,
-                   progress, f, diag, seconds_)) {
+                   size_t(params_.tile_index), tile_margin(), params_, progress,
+                   f, diag, seconds_)) {
     surf.tris.reserve(f.tris.size());
     for (uint32_t v : f.tris)
       surf.tris.push_back(f.to_input[v]);
@@ -665,12 +663,7 @@ sc_mesh_t *Recon::finish_tile(const double *work, Progress &progress,
     diag.tiles = 0; // the merge runs the job on one triangulation
   }
   diag.triangles = surf.tris.size() / 3;
-  for (int s = 0; s < SC_STAGE_COUNT; ++s) {
-    diag.seconds[s] = seconds_[s];
-    diag.seconds_total += seconds_[s];
-  }
-  progress.report(1.0);
-  return with_smoothed(mesh_out(surf, normals, n_, diag));
+  return result(surf, normals, diag, progress);
 }
 
 } // namespace sc
