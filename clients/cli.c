@@ -274,6 +274,10 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
             : r->params.memory_limit > 0 ? "it fits the memory limit"
             : r->params.tiles == 0 && r->params.threads == 1
                 ? "one tile per thread, and one thread"
+            : d->tile_points_foreign
+                ? "the tiles' Delaunay balls reach far across each other "
+                  "(as inside a closed surface's sample), so one "
+                  "triangulation is faster"
                 : "too few points to split (2000 a tile)");
   fprintf(f, "Time: read %.3f s", r->seconds_read);
   if (r->seconds_transfer > 0)

@@ -167,7 +167,8 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    triangulations are certified against each other, so that the mesh is
  *    the one a single triangulation gives, triangle for triangle
  *    (docs/algorithm.md section 17). 1, the default, never tiles; 0 means
- *    one per thread.
+ *    one per thread, given up for one triangulation where the tiles would
+ *    cost more (diag.tiles 0, diag.tile_points_foreign not: section 17.4).
  *  - boundary_rho (boundary, watertight and auto modes): a sample passes
  *    the ratio test when the farthest Voronoi vertex of its cell inside its
  *    cocone is at most boundary_rho times the distance to its negative
@@ -231,7 +232,8 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
   X(tiles, int, INT, 1, 0, 4096, SC_RANGE_CLOSED, "in [0, 4096]", LOCAL, 0,    \
     "tiles", "N",                                                              \
     "split the points into N tiles triangulated apart, on the threads; the "   \
-    "same mesh whatever N; 0 = one per thread (cocone and shortcrust modes)")  \
+    "same mesh whatever N; 0 = one per thread, while tiles pay (cocone and "   \
+    "shortcrust modes)")                                                       \
   X(memory_limit, double, BYTES, 0, 0, 1e300,                                  \
     SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "positive", LOCAL, 0,            \
     "memory-limit", "BYTES",                                                   \
@@ -439,7 +441,8 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
   X(tiles, uint64_t, , COUNT, "tiles",                                         \
     "tiles the points were split into (0: one triangulation of all)")          \
   X(tile_points_foreign, uint64_t, , COUNT, "tile_points_foreign",             \
-    "points triangulated in a tile besides its own: the tiles' overhead")
+    "points triangulated in a tile besides its own: the tiles' overhead; "     \
+    "with tiles 0, those a tile had taken in when it gave up")
 
 typedef struct sc_diag {
 #define SC_DIAG_FIELD_(field, type, dim, kind, wire, help) type field dim;

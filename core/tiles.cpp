@@ -37,10 +37,46 @@ constexpr size_t kMinTilePoints = 2000;
 // index.
 constexpr uint8_t kSeen = 0x80;
 // CellData while the tiles are certified (the poles stage writes the
-// circumcentre over it): the cell was checked, a NaN no arithmetic gives;
-// kRingChecked likewise for the second round of a tile job's (certify()).
-constexpr uint32_t kChecked = 0x7fc5a5a6u;
-constexpr uint32_t kRingChecked = 0x7fc5a5a7u;
+// circumcentre over it): the cell is final or needs no check (`checked`),
+// or its check was left to the sweep (`open`); NaNs no arithmetic gives,
+// a pair for each round of certify().
+struct Marks {
+  uint32_t checked, open;
+};
+constexpr Marks kFirstRound{0x7fc5a5a6u, 0x7fc5a5a8u};
+constexpr Marks kRingRound{0x7fc5a5a7u, 0x7fc5a5a9u};
+// A cell's own search for a point in its ball reads at most this many
+// leaves of the tree before it leaves the cell to the sweep (certify()).
+constexpr size_t kLeafBudget = 48;
+// A tile that takes in more foreign points than this many times its own,
+// or whose certification costs more than this many leaves of the tree (see
+// kCellCost below) for each point it owns, gives up, and the job runs on
+// one triangulation instead (certify()). Scans cost 2 to 40 (the merged
+// bunny scans in 4 to 64 tiles); samples of closed surfaces, where tiles
+// cost more than one triangulation, 200 to 20 000.
+constexpr double kMostForeign = 1.0;
+constexpr double kMostWork = 200;
+// Thrown by certify() when a tile gives up.
+struct NotTileable {
+  size_t foreign; // the points the tile had taken in
+};
+
+// What the open cells cost (certify()), in leaves of the tree read: a
+// cell's own search without a budget, about (with the cells that the
+// points it finds make), and the sweep, for each point it locates.
+constexpr double kCellCost = 256;
+constexpr double kSweepCost = 512;
+// ... and a point's test against a cell's ball (exact when it is nearly on
+// the sphere, as all are in a sample of a sphere).
+constexpr double kTestCost = 16;
+// The sweep takes its points in this many bands of distance from the
+// reach, out to the farthest open ball.
+constexpr double kSweepBands = 32;
+
+// A box; a side at infinity where the tile reaches the outside.
+struct Box {
+  double lo[3], hi[3];
+};
 
 // A static k-d tree over the distinct points, by vertex number: which
 // points lie in a ball. Read by every tile's thread at once; nothing in it
@@ -61,14 +97,31 @@ public:
   // the box `skip`, that f(v) accepts; UINT32_MAX for none. Nearer parts
   // of the tree first, and the radius shrinks to each point accepted, so
   // that a ball holding many points costs little more than an empty one.
+  // At most `leaves` leaves are read: when the search needs more it stops
+  // and sets `leaves` to 0, and what it returns is a point in the ball, if
+  // one was found, but maybe not the nearest.
   template <class F>
   uint32_t nearest_in_ball(const double c[3], double r2,
                            const double skip_lo[3], const double skip_hi[3],
-                           F &&f) const {
+                           F &&f, size_t &leaves) const {
     uint32_t best = UINT32_MAX;
     if (!nodes_.empty())
-      visit(0, box_d2(nodes_[0], c), c, r2, skip_lo, skip_hi, f, best);
+      visit(0, box_d2(nodes_[0], c), c, r2, skip_lo, skip_hi, f, best, leaves);
     return best;
+  }
+
+  // Calls f(v) on every point v in the closed box [lo, hi] outside the box
+  // `skip`.
+  template <class F>
+  void in_box(const double lo[3], const double hi[3], const double skip_lo[3],
+              const double skip_hi[3], F &&f) const {
+    if (!nodes_.empty())
+      box_visit(0, lo, hi, skip_lo, skip_hi, f);
+  }
+
+  // How many points lie in the closed box [lo, hi].
+  size_t count_in_box(const double lo[3], const double hi[3]) const {
+    return nodes_.empty() ? 0 : box_count(0, lo, hi);
   }
 
   // The nearest to c of the points v on the outer side of the plane
@@ -88,6 +141,14 @@ public:
       visit_beyond(0, box_d2(nodes_[0], c), c, r2, a, nrm, tol, skip_lo,
                    skip_hi, f, best);
     return best;
+  }
+  // The box of all the points.
+  Box bounds() const {
+    Box b;
+    for (int a = 0; a < 3; ++a)
+      b.lo[a] = nodes_.empty() ? 0 : nodes_[0].lo[a],
+      b.hi[a] = nodes_.empty() ? 0 : nodes_[0].hi[a];
+    return b;
   }
   // The length of the diagonal of the box of all the points.
   double extent() const {
@@ -201,16 +262,59 @@ private:
     return d2;
   }
 
+  // Whether node nd lies in the closed box [lo, hi].
+  static bool node_in(const Node &nd, const double lo[3], const double hi[3]) {
+    return nd.lo[0] >= lo[0] && nd.hi[0] <= hi[0] && nd.lo[1] >= lo[1] &&
+           nd.hi[1] <= hi[1] && nd.lo[2] >= lo[2] && nd.hi[2] <= hi[2];
+  }
+  // Whether node nd meets the closed box [lo, hi].
+  static bool node_meets(const Node &nd, const double lo[3],
+                         const double hi[3]) {
+    return nd.hi[0] >= lo[0] && nd.lo[0] <= hi[0] && nd.hi[1] >= lo[1] &&
+           nd.lo[1] <= hi[1] && nd.hi[2] >= lo[2] && nd.lo[2] <= hi[2];
+  }
+
+  template <class F>
+  void box_visit(int32_t id, const double lo[3], const double hi[3],
+                 const double skip_lo[3], const double skip_hi[3], F &f) const {
+    const Node &nd = nodes_[size_t(id)];
+    if (!node_meets(nd, lo, hi) || node_in(nd, skip_lo, skip_hi))
+      return;
+    if (nd.left >= 0) {
+      box_visit(nd.left, lo, hi, skip_lo, skip_hi, f);
+      box_visit(nd.right, lo, hi, skip_lo, skip_hi, f);
+      return;
+    }
+    for (uint32_t i = nd.begin; i < nd.end; ++i) {
+      const double *p = &xyz_[3 * size_t(i)];
+      if (in_skip(p, lo, hi) && !in_skip(p, skip_lo, skip_hi))
+        f(idx_[i]);
+    }
+  }
+
+  size_t box_count(int32_t id, const double lo[3], const double hi[3]) const {
+    const Node &nd = nodes_[size_t(id)];
+    if (!node_meets(nd, lo, hi))
+      return 0;
+    if (node_in(nd, lo, hi))
+      return nd.end - nd.begin;
+    if (nd.left >= 0)
+      return box_count(nd.left, lo, hi) + box_count(nd.right, lo, hi);
+    size_t k = 0;
+    for (uint32_t i = nd.begin; i < nd.end; ++i)
+      k += in_skip(&xyz_[3 * size_t(i)], lo, hi);
+    return k;
+  }
+
   template <class F>
   void visit(int32_t id, double d2, const double c[3], double &r2,
              const double skip_lo[3], const double skip_hi[3], F &f,
-             uint32_t &best) const {
+             uint32_t &best, size_t &leaves) const {
     const Node &nd = nodes_[size_t(id)];
-    if (d2 > r2 || (nd.lo[0] >= skip_lo[0] && nd.hi[0] <= skip_hi[0] &&
-                    nd.lo[1] >= skip_lo[1] && nd.hi[1] <= skip_hi[1] &&
-                    nd.lo[2] >= skip_lo[2] && nd.hi[2] <= skip_hi[2]))
+    if (d2 > r2 || leaves == 0 || node_in(nd, skip_lo, skip_hi))
       return;
     if (nd.left < 0) {
+      --leaves;
       for (uint32_t i = nd.begin; i < nd.end; ++i) {
         const double *p = &xyz_[3 * size_t(i)];
         const double dx = p[0] - c[0], dy = p[1] - c[1], dz = p[2] - c[2];
@@ -225,11 +329,11 @@ private:
     const double dl = box_d2(nodes_[size_t(nd.left)], c),
                  dr = box_d2(nodes_[size_t(nd.right)], c);
     if (dl <= dr) {
-      visit(nd.left, dl, c, r2, skip_lo, skip_hi, f, best);
-      visit(nd.right, dr, c, r2, skip_lo, skip_hi, f, best);
+      visit(nd.left, dl, c, r2, skip_lo, skip_hi, f, best, leaves);
+      visit(nd.right, dr, c, r2, skip_lo, skip_hi, f, best, leaves);
     } else {
-      visit(nd.right, dr, c, r2, skip_lo, skip_hi, f, best);
-      visit(nd.left, dl, c, r2, skip_lo, skip_hi, f, best);
+      visit(nd.right, dr, c, r2, skip_lo, skip_hi, f, best, leaves);
+      visit(nd.left, dl, c, r2, skip_lo, skip_hi, f, best, leaves);
     }
   }
 
@@ -237,11 +341,6 @@ private:
   std::vector<uint32_t> idx_;
   std::vector<double> xyz_; // idx_'s points, in its order
   std::vector<Node> nodes_;
-};
-
-// A box; a side at infinity where the tile reaches the outside.
-struct Box {
-  double lo[3], hi[3];
 };
 
 struct Tile {
@@ -262,6 +361,7 @@ struct Tile {
   std::vector<uint32_t> vertices;
   sc_diag_t diag;
   size_t foreign = 0; // points of other tiles inserted
+  double work = 0;    // of certify(): leaves of the tree read, and sweeping
   Tile() { std::memset(&diag, 0, sizeof diag); }
 };
 
@@ -574,15 +674,39 @@ std::vector<Vh> insert_foreign(const Shared &s, Tile &t,
   return made;
 }
 
-// Marks cell c checked (the mark `sentinel`); returns whether it was
-// already.
-inline bool checked_before(Ch c, uint32_t sentinel) {
+inline uint32_t mark_of(Ch c) {
   uint32_t bits;
   std::memcpy(&bits, &c->info().cc[0], sizeof bits);
-  if (bits == sentinel)
-    return true;
-  std::memcpy(&c->info().cc[0], &sentinel, sizeof bits);
-  return false;
+  return bits;
+}
+inline void set_mark(Ch c, uint32_t bits) {
+  std::memcpy(&c->info().cc[0], &bits, sizeof bits);
+}
+
+// The distance from p to the box (0 inside).
+inline double box_distance(const Box &box, const double p[3]) {
+  double d2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double d = std::max({box.lo[a] - p[a], p[a] - box.hi[a], 0.0});
+    d2 += d * d;
+  }
+  return std::sqrt(d2);
+}
+
+// How far from box `reach` a point of `all` in the ball (centre c, radius
+// r) can be: the farthest corner of the ball's box clipped to `all`. (A
+// nearly flat cell's ball is huge, but only a thin lens of it holds
+// points.)
+inline double ball_extent(const Box &reach, const Box &all, const double c[3],
+                          double r) {
+  double d2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double lo = std::max(c[a] - r, all.lo[a]),
+                 hi = std::min(c[a] + r, all.hi[a]);
+    const double d = std::max({reach.lo[a] - lo, hi - reach.hi[a], 0.0});
+    d2 += d * d;
+  }
+  return std::sqrt(d2);
 }
 
 // Which cells certify() makes final: those with a vertex for which want
@@ -594,19 +718,27 @@ struct Wanted {
   bool operator()(uint32_t v) const { return own(v) || (ring && (*ring)[v]); }
 };
 
-// Checks finite cell c of tile t (see certify()); a point that makes it
-// wrong goes into add.
-void check_cell(const Shared &s, Tile &t, const Ownership &own,
-                const Wanted &want, Ch c, std::vector<uint32_t> &add) {
-  bool mine = false;
+// Whether a vertex of finite cell c is wanted.
+inline bool wanted_cell(const Wanted &want, Ch c) {
   for (int j = 0; j < 4; ++j)
-    mine = mine || want(c->vertex(j)->info().idx);
-  if (!mine)
-    return;
+    if (want(c->vertex(j)->info().idx))
+      return true;
+  return false;
+}
+
+// Checks finite cell c of tile t (see certify()), reading at most `leaves`
+// leaves of the tree; a point that makes it wrong goes into add. True when
+// the check needed more leaves and found no such point: it is the sweep's.
+bool check_cell(const Shared &s, Tile &t, const Ownership &own,
+                const Wanted &want, Ch c, std::vector<uint32_t> &add,
+                size_t leaves) {
+  if (!wanted_cell(want, c))
+    return false;
   double centre[3], r;
   enclosing_ball(c, centre, r);
   if (ball_in(t.reach, centre, r))
-    return;
+    return false;
+  const size_t budget = leaves;
   const double r2 = r * r;
   const Point &p0 = c->vertex(0)->point(), &p1 = c->vertex(1)->point(),
               &p2 = c->vertex(2)->point(), &p3 = c->vertex(3)->point();
@@ -615,16 +747,23 @@ void check_cell(const Shared &s, Tile &t, const Ownership &own,
   // (Taking every point inside a wrong ball, which may be far larger than
   // any cell of all, took in most of the other tiles.)
   const uint32_t best = s.tree->nearest_in_ball(
-      centre, r2, t.reach.lo, t.reach.hi, [&](uint32_t v) {
+      centre, r2, t.reach.lo, t.reach.hi,
+      [&](uint32_t v) {
         if (own(v) || t.member[v])
           return false;
+        t.work += kTestCost;
         const double *q = s.pts + 3 * size_t(v);
         return CGAL::side_of_bounded_sphere(p0, p1, p2, p3,
                                             Point(q[0], q[1], q[2])) !=
                CGAL::ON_UNBOUNDED_SIDE;
-      });
-  if (best != UINT32_MAX)
+      },
+      leaves);
+  t.work += double(budget - leaves);
+  if (best != UINT32_MAX) {
     add.push_back(best);
+    return false;
+  }
+  return leaves == 0;
 }
 
 // Checks infinite cell c of tile t: its hull facet is one of all the points
@@ -674,53 +813,233 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own,
 // all that the tile lacks; a hull facet has none beyond it. A ball inside
 // the tile's reach is certified as it is; the others ask the tree, and
 // the exact predicates decide. Points that make a cell wrong go in, and the
-// cells they make, which are all around them, are checked in the next
-// round. A certified cell stays so: no point of all is in its ball, so
-// nothing inserted later destroys it.
+// cells they make, which are all around them, are checked in turn. A
+// certified cell stays so: no point of all is in its ball, so nothing
+// inserted later destroys it.
+//
+// A ball that the surface touches along a whole circle (the inner balls
+// of a closed surface's samples) has many points just outside it, and the
+// tree reads them all, for each such cell. So a cell's own search stops
+// after kLeafBudget leaves, and the cells left open are certified
+// together by a sweep over the points instead: each point the tile lacks
+// within reach of an open ball, nearest the tile first, is located in the
+// tile's triangulation and goes in when it conflicts with a wanted cell.
+// That suffices: when a point q goes in, each new cell (q and a facet f of
+// the hole) has its ball inside the balls of the two cells that had f
+// (the three spheres pass through f's circle), and those have f's
+// vertices, so were wanted if the new cell is. So every wanted ball, at
+// any time, lies in the union of the wanted balls at the start of the
+// sweep, and a point found in none of the wanted balls of its moment is
+// in none later. The sweep ends at the first point farther from the reach
+// than every open ball extends (docs/algorithm.md section 17.2).
+//
+// Where the balls of the cells reach far across the tiles (samples of a
+// closed surface: the inner balls of a sphere's sample hold nearly all of
+// it), a tile takes in most of the others' points, and the tiles would
+// cost many times one triangulation of all. With `give_up`, a tile that
+// takes in more than kMostForeign times its own points throws
+// NotTileable.
 //
 // A tile job (tile_job()) runs alone: nothing gives it the poles of the
 // foreign vertices of the facets it tests. With `ring`, a second round
 // then certifies every cell around the neighbours of its own vertices too
 // (their neighbour sets are final once the first round is done), so that
 // the tile computes their poles itself, exactly.
-void certify(const Shared &s, Tile &t, Progress &progress, bool ring = false) {
+void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
+             bool give_up) {
   const Ownership own{s.owner, t.id};
+  const Box all = s.tree->bounds();
+  size_t owned = 0;
+  for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
+       ++v)
+    owned += own(v->info().idx);
+  const double most_foreign = give_up ? kMostForeign * double(owned) : HUGE_VAL;
+  const double most_work = give_up ? kMostWork * double(owned) : HUGE_VAL;
+  auto too_many = [&]() {
+    if (double(t.foreign) > most_foreign || t.work > most_work)
+      throw NotTileable{t.foreign};
+  };
   std::vector<uint32_t> add;
   std::vector<Ch> around;
-  auto round = [&](const Wanted &want, uint32_t sentinel) {
+  auto round = [&](const Wanted &want, const Marks marks) {
+    // One cell's check, once.
+    auto check = [&](Ch c) {
+      const uint32_t m = mark_of(c);
+      if (m == marks.checked || m == marks.open)
+        return;
+      set_mark(c, marks.checked);
+      if (t.dt.is_infinite(c))
+        check_hull(s, t, own, want, c, add);
+      else if (check_cell(s, t, own, want, c, add, kLeafBudget))
+        set_mark(c, marks.open);
+      too_many();
+    };
+    // The points in add go in, and the cells they make are checked.
+    auto drain = [&]() {
+      while (!add.empty()) {
+        std::sort(add.begin(), add.end());
+        add.erase(std::unique(add.begin(), add.end()), add.end());
+        const std::vector<Vh> made = insert_foreign(s, t, add, progress);
+        add.clear();
+        too_many();
+        for (Vh v : made) {
+          around.clear();
+          t.dt.incident_cells(v, std::back_inserter(around));
+          for (Ch c : around)
+            check(c);
+        }
+      }
+    };
+    // The wanted finite cells not yet certified, with how far beyond the
+    // reach their balls extend; the farthest such extent (-1 for none).
+    std::vector<std::pair<double, Ch>> open;
+    auto uncertified = [&](bool list) {
+      double most = -1;
+      open.clear();
+      for_cells(t.dt, false, [&](Ch c) {
+        if (mark_of(c) == marks.checked)
+          return;
+        double centre[3], r;
+        if (wanted_cell(want, c)) {
+          enclosing_ball(c, centre, r);
+          // Extent 0: what of the ball holds points is in the reach.
+          const double e = ball_in(t.reach, centre, r)
+                               ? 0
+                               : ball_extent(t.reach, all, centre, r);
+          if (e > 0) {
+            most = std::max(most, e);
+            if (list)
+              open.emplace_back(e, c);
+            return;
+          }
+        }
+        set_mark(c, marks.checked);
+      });
+      return most;
+    };
+    // Sweeps the points within `extent` of the reach (see above), in
+    // bands of distance, and in each band in vertex order, which is a
+    // Hilbert order: each point is located near the one before.
+    std::vector<std::pair<uint32_t, uint32_t>> cand; // band, vertex
+    std::vector<std::pair<Ch, int>> hole;
+    auto sweep = [&](double extent) {
+      double lo[3], hi[3];
+      for (int a = 0; a < 3; ++a)
+        lo[a] = t.reach.lo[a] - extent, hi[a] = t.reach.hi[a] + extent;
+      const double band = extent / kSweepBands;
+      cand.clear();
+      s.tree->in_box(lo, hi, t.reach.lo, t.reach.hi, [&](uint32_t v) {
+        if (!own(v) && !t.member[v])
+          cand.emplace_back(
+              uint32_t(
+                  std::min(box_distance(t.reach, s.pts + 3 * size_t(v)) / band,
+                           double(2 * kSweepBands))),
+              v);
+      });
+      std::sort(cand.begin(), cand.end());
+      Ch hint;
+      size_t rescan = 1024;
+      for (size_t k = 0; k < cand.size(); ++k) {
+        progress.tick(k, cand.size());
+        // The open balls shrink as points go in: look again now and then.
+        const double near = cand[k].first * band;
+        if (near > extent || k == rescan) {
+          extent = uncertified(false);
+          rescan *= 2;
+          if (near > extent)
+            break;
+        }
+        const uint32_t v = cand[k].second;
+        const double *q = s.pts + 3 * size_t(v);
+        const Point p(q[0], q[1], q[2]);
+        const Ch c = t.dt.locate(p, hint);
+        t.work += kSweepCost;
+        hole.clear();
+        t.dt.find_conflicts(p, c, std::back_inserter(hole),
+                            CGAL::Emptyset_iterator());
+        // Every vertex of a cell in conflict is on the hole's boundary.
+        bool hit = false;
+        for (size_t h = 0; h < hole.size() && !hit; ++h)
+          for (int j = 0; j < 4 && !hit; ++j) {
+            const Vh w = hole[h].first->vertex(j);
+            hit = j != hole[h].second && !t.dt.is_infinite(w) &&
+                  want(w->info().idx);
+          }
+        if (!hit) {
+          hint = c;
+          continue;
+        }
+        const Vh w = t.dt.insert(p, c);
+        w->info() = VertexData(v);
+        t.member[v] = true;
+        ++t.foreign;
+        too_many();
+        hint = w->cell();
+      }
+    };
+
     size_t cells = t.dt.number_of_cells(), k = 0;
     for_cells(t.dt, false, [&](Ch c) {
       progress.tick(k++, cells);
-      if (!checked_before(c, sentinel))
-        check_cell(s, t, own, want, c, add);
+      check(c);
     });
-    {
-      std::vector<Ch> hull;
+    std::vector<Ch> hull;
+    t.dt.incident_cells(t.dt.infinite_vertex(), std::back_inserter(hull));
+    for (Ch c : hull)
+      check(c);
+    drain();
+    for (;;) {
+      if (uncertified(true) < 0)
+        break;
+      // The open balls that reach farthest search alone, the others are
+      // swept: as many of each as cost the least.
+      std::sort(
+          open.begin(), open.end(),
+          [](const std::pair<double, Ch> &a, const std::pair<double, Ch> &b) {
+            return a.first > b.first;
+          });
+      const size_t inside = s.tree->count_in_box(t.reach.lo, t.reach.hi);
+      auto cost = [&](size_t alone) {
+        double c = kCellCost * double(alone);
+        if (alone < open.size()) {
+          double lo[3], hi[3];
+          const double e = open[alone].first;
+          for (int a = 0; a < 3; ++a)
+            lo[a] = t.reach.lo[a] - e, hi[a] = t.reach.hi[a] + e;
+          c += kSweepCost * double(s.tree->count_in_box(lo, hi) - inside);
+        }
+        return c;
+      };
+      size_t first = open.size();
+      double least = cost(first);
+      for (size_t i = 0; i < open.size(); i = 2 * i + 1) {
+        const double c = cost(i);
+        if (c < least)
+          least = c, first = i;
+      }
+      for (size_t i = 0; i < first; ++i) {
+        set_mark(open[i].second, marks.checked);
+        (void)check_cell(s, t, own, want, open[i].second, add, SIZE_MAX);
+        too_many();
+      }
+      if (!add.empty()) {
+        drain();
+        continue;
+      }
+      if (first < open.size())
+        sweep(open[first].first);
+      // The hull facets the sweep made (it adds none that are wanted, by
+      // the argument above; this checks it).
+      hull.clear();
       t.dt.incident_cells(t.dt.infinite_vertex(), std::back_inserter(hull));
       for (Ch c : hull)
-        if (!checked_before(c, sentinel))
-          check_hull(s, t, own, want, c, add);
-    }
-    while (!add.empty()) {
-      std::sort(add.begin(), add.end());
-      add.erase(std::unique(add.begin(), add.end()), add.end());
-      const std::vector<Vh> made = insert_foreign(s, t, add, progress);
-      add.clear();
-      for (Vh v : made) {
-        around.clear();
-        t.dt.incident_cells(v, std::back_inserter(around));
-        for (Ch c : around) {
-          if (checked_before(c, sentinel))
-            continue;
-          if (t.dt.is_infinite(c))
-            check_hull(s, t, own, want, c, add);
-          else
-            check_cell(s, t, own, want, c, add);
-        }
-      }
+        check(c);
+      if (add.empty())
+        break;
+      drain();
     }
   };
-  round(Wanted{own, nullptr}, kChecked);
+  round(Wanted{own, nullptr}, kFirstRound);
   if (!ring)
     return;
   std::vector<bool> near(t.member.size(), false);
@@ -732,7 +1051,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring = false) {
       for (int j = 0; j < 4; ++j)
         near[c->vertex(j)->info().idx] = true;
   });
-  round(Wanted{own, &near}, kRingChecked);
+  round(Wanted{own, &near}, kRingRound);
 }
 
 } // namespace
@@ -918,15 +1237,16 @@ std::vector<uint32_t> in_reach(const Tile &t, const std::vector<double> &pts,
 // Grows tile t, triangulated from its own points, by the foreign points in
 // its reach and then until its cells are certified (certify(); with ring,
 // one ring more). False, having certified nothing, when the tile spans no
-// volume.
+// volume; with give_up, NotTileable when the tile takes in too many
+// (certify()).
 bool grow_tile(const Shared &s, Tile &t, const std::vector<double> &pts,
-               const std::vector<uint16_t> &owner, bool ring,
+               const std::vector<uint16_t> &owner, bool ring, bool give_up,
                Progress &progress) {
   t.member.assign(owner.size(), false);
   (void)insert_foreign(s, t, in_reach(t, pts, owner), progress);
   if (t.dt.dimension() < 3)
     return false;
-  certify(s, t, progress, ring);
+  certify(s, t, progress, ring, give_up);
   return true;
 }
 
@@ -986,6 +1306,9 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
   // hull and its margin, and certified.
   out.poles.assign(3 * m, 0.0);
   std::atomic<int> flat{0};
+  // Tiles asked for by number are run whatever they cost; one a thread
+  // (tiles 0) only while they pay (certify()).
+  const bool give_up = !bounded && params.tiles == 0;
   auto grow = [&](Tile &t, Progress &p) {
     if (bounded) {
       triangulate_vertices(pts.data(), own_vertices(t, rank), t, p);
@@ -994,7 +1317,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
            v != t.dt.finite_vertices_end(); ++v)
         v->info() = VertexData(rank[v->info().idx]);
     }
-    if (grow_tile(shared, t, pts, owner, false, p))
+    if (grow_tile(shared, t, pts, owner, false, give_up, p))
       return true;
     flat = 1;
     return false;
@@ -1054,8 +1377,13 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
       candidates(t, p);
     });
   } else {
-    run_tiles(k, threads, progress,
-              [&](size_t i, Progress &p) { (void)grow(ts[i], p); });
+    try {
+      run_tiles(k, threads, progress,
+                [&](size_t i, Progress &p) { (void)grow(ts[i], p); });
+    } catch (const NotTileable &e) {
+      diag.tile_points_foreign = e.foreign;
+      return false;
+    }
     if (flat.load())
       return false;
     seconds[SC_STAGE_DELAUNAY] += sw.lap();
@@ -1115,7 +1443,7 @@ bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
   const Shared shared{pts.data(), owner.data(), &tree};
   triangulate_vertices(pts.data(), mine, t, progress);
   mine = {};
-  if (!grow_tile(shared, t, pts, owner, true, progress))
+  if (!grow_tile(shared, t, pts, owner, true, false, progress))
     return false;
   seconds[SC_STAGE_DELAUNAY] += sw.lap();
 

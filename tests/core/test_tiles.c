@@ -267,6 +267,42 @@ cancel : {
     EXPECT_NULL(t);
   }
 
+  /* One tile a thread (tiles 0) gives up where the tiles would cost more
+   * than one triangulation, as on this exact sample of a torus, whose
+   * inner Delaunay balls reach across the tiles, and runs one
+   * triangulation: the same mesh, and tile_points_foreign says how far
+   * the tiles got. The tiles of a scan pay, and are kept. */
+  {
+    sc_mesh_t *one = run("torus", xyz, n, SC_MODE_COCONE, 1, 1);
+    sc_mesh_t *t = run("torus", xyz, n, SC_MODE_COCONE, 0, 2);
+    if (one && t) {
+      EXPECT_EQ(t->diag.tiles, 0);
+      EXPECT_GT(t->diag.tile_points_foreign, 0);
+      EXPECT_EQ(t->triangle_count, one->triangle_count);
+      EXPECT_EQ(memcmp(t->triangles, one->triangles,
+                       3 * one->triangle_count * sizeof *one->triangles),
+                0);
+      printf("ok: one tile a thread gave up on the exact torus after %llu "
+             "points, one triangulation instead\n",
+             (unsigned long long)t->diag.tile_points_foreign);
+    }
+    sc_mesh_free(one);
+    sc_mesh_free(t);
+    for (int a = 1; a < argc; ++a) {
+      scf_points_t pts;
+      char msg[256];
+      if (scf_points_read(argv[a], &pts, msg, sizeof msg) != 0)
+        continue;
+      one = run(argv[a], pts.xyz, pts.count, SC_MODE_COCONE, 1, 1);
+      t = run(argv[a], pts.xyz, pts.count, SC_MODE_COCONE, 0, 2);
+      if (one && t)
+        same(argv[a], one, t, 0, 2);
+      sc_mesh_free(one);
+      sc_mesh_free(t);
+      scf_points_free(&pts);
+    }
+  }
+
   /* Tile jobs: what cannot be one job's tiles is refused, and so are tile
    * jobs the parameters do not allow. */
   {
