@@ -78,6 +78,14 @@ struct Box {
   double lo[3], hi[3];
 };
 
+// Box b grown by d on every side.
+inline Box grown(const Box &b, double d) {
+  Box g;
+  for (int a = 0; a < 3; ++a)
+    g.lo[a] = b.lo[a] - d, g.hi[a] = b.hi[a] + d;
+  return g;
+}
+
 // A static k-d tree over the distinct points, by vertex number: which
 // points lie in a ball. Read by every tile's thread at once; nothing in it
 // changes after construction.
@@ -923,12 +931,10 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
     std::vector<std::pair<uint32_t, uint32_t>> cand; // band, vertex
     std::vector<std::pair<Ch, int>> hole;
     auto sweep = [&](double extent) {
-      double lo[3], hi[3];
-      for (int a = 0; a < 3; ++a)
-        lo[a] = t.reach.lo[a] - extent, hi[a] = t.reach.hi[a] + extent;
+      const Box out = grown(t.reach, extent);
       const double band = extent / kSweepBands;
       cand.clear();
-      s.tree->in_box(lo, hi, t.reach.lo, t.reach.hi, [&](uint32_t v) {
+      s.tree->in_box(out.lo, out.hi, t.reach.lo, t.reach.hi, [&](uint32_t v) {
         if (!own(v) && !t.member[v])
           cand.emplace_back(
               uint32_t(
@@ -983,10 +989,15 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
       progress.tick(k++, cells);
       check(c);
     });
+    // The hull facets not yet checked.
     std::vector<Ch> hull;
-    t.dt.incident_cells(t.dt.infinite_vertex(), std::back_inserter(hull));
-    for (Ch c : hull)
-      check(c);
+    auto check_hull_cells = [&]() {
+      hull.clear();
+      t.dt.incident_cells(t.dt.infinite_vertex(), std::back_inserter(hull));
+      for (Ch c : hull)
+        check(c);
+    };
+    check_hull_cells();
     drain();
     for (;;) {
       if (uncertified(true) < 0)
@@ -1002,11 +1013,9 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
       auto cost = [&](size_t alone) {
         double c = kCellCost * double(alone);
         if (alone < open.size()) {
-          double lo[3], hi[3];
-          const double e = open[alone].first;
-          for (int a = 0; a < 3; ++a)
-            lo[a] = t.reach.lo[a] - e, hi[a] = t.reach.hi[a] + e;
-          c += kSweepCost * double(s.tree->count_in_box(lo, hi) - inside);
+          const Box out = grown(t.reach, open[alone].first);
+          c += kSweepCost *
+               double(s.tree->count_in_box(out.lo, out.hi) - inside);
         }
         return c;
       };
@@ -1030,10 +1039,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
         sweep(open[first].first);
       // The hull facets the sweep made (it adds none that are wanted, by
       // the argument above; this checks it).
-      hull.clear();
-      t.dt.incident_cells(t.dt.infinite_vertex(), std::back_inserter(hull));
-      for (Ch c : hull)
-        check(c);
+      check_hull_cells();
       if (add.empty())
         break;
       drain();
@@ -1145,9 +1151,7 @@ std::vector<Tile> make_tiles(const double *xyz, size_t n, size_t tiles,
   split(xyz, idx, 0, n, tiles, all, ts);
   for (size_t i = 0; i < ts.size(); ++i) {
     ts[i].id = uint16_t(i);
-    for (int a = 0; a < 3; ++a)
-      ts[i].reach.lo[a] = ts[i].region.lo[a] - margin,
-      ts[i].reach.hi[a] = ts[i].region.hi[a] + margin;
+    ts[i].reach = grown(ts[i].region, margin);
   }
   return ts;
 }
