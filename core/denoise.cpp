@@ -5,6 +5,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 
 #include "internal.hpp"
+#include "parallel.hpp"
 
 #include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Search_traits_3.h>
@@ -417,17 +418,41 @@ private:
   std::vector<uint64_t> keys_;
 };
 
+// Points per block of smoothing's loops, which run on the job's threads.
+constexpr size_t kBlock = 4096;
+
+// Runs fn(first, last) over the blocks of [0, n) on `threads` threads,
+// reporting progress from `from` to `to` (one thread runs them in order,
+// here). A point's result must not depend on another block's work: then it
+// is the same with any number of threads.
+template <class F>
+void for_blocks(size_t n, unsigned threads, Progress &progress, double from,
+                double to, F &&fn) {
+  const size_t k = (n + kBlock - 1) / kBlock;
+  auto block = [&](size_t b) { fn(b * kBlock, std::min(n, (b + 1) * kBlock)); };
+  if (threads <= 1) {
+    for (size_t b = 0; b < k; ++b) {
+      block(b);
+      progress.report(from + (to - from) * double(b + 1) / double(k));
+    }
+    return;
+  }
+  run_parallel(
+      k, threads, progress, [&](size_t b, Progress &) { block(b); }, from, to);
+}
+
 // The neighbours of each point within r, found once, as lists of
-// positions in the grid's order (CSR: the list of point q is
-// list[first[q] .. first[q + 1])), and the points in that order.
+// positions in the grid's order (point q's are the first count[q] of the
+// kMaxNeighbours slots at of(q)), and the points in that order.
 struct Neighbourhoods {
   std::vector<uint32_t> order; // position -> input index
-  std::vector<size_t> first;
-  std::vector<uint32_t> list;
+  std::vector<uint8_t> count;
+  std::unique_ptr<uint32_t[]> list;
+  const uint32_t *of(size_t q) const { return &list[q * kMaxNeighbours]; }
 };
 
-void find_neighbours(const double *xyz, size_t n, double r, Progress &progress,
-                     Neighbourhoods &nb) {
+void find_neighbours(const double *xyz, size_t n, double r, unsigned threads,
+                     Progress &progress, Neighbourhoods &nb) {
   // Cells have half the radius as side: the ball about a point of a cell
   // lies in the 5 x 5 x 5 cells around it, less the four columns at the
   // corners, whose nearest point is farther than r. Each column of five
@@ -442,75 +467,77 @@ void find_neighbours(const double *xyz, size_t n, double r, Progress &progress,
   }
   const double r2 = r * r;
   constexpr uint64_t kAxis = (uint64_t(1) << 21) - 1;
-  nb.first.assign(n + 1, 0);
-  // At most kMaxNeighbours each: room for all, so that the list is never
-  // copied as it grows.
-  nb.list.clear();
-  nb.list.reserve(n * kMaxNeighbours);
-  std::vector<uint32_t> found;
-  size_t ranges[21][2];
-  for (size_t first = 0; first < n;) {
-    const uint64_t key = keys[first];
-    size_t last = first;
-    while (last < n && keys[last] == key)
-      ++last;
-    const uint64_t cx = key >> 42, cy = (key >> 21) & kAxis;
-    int nr = 0;
-    for (int dx = -2; dx <= 2; ++dx)
-      for (int dy = -2; dy <= 2; ++dy) {
-        if ((dx == -2 || dx == 2) && (dy == -2 || dy == 2))
-          continue;
-        const uint64_t k0 = (uint64_t(int64_t(cx) + dx) << 42) |
-                            (uint64_t(int64_t(cy) + dy) << 21) |
-                            ((key & kAxis) - 2);
-        // Columns after this cell's start at or after it.
-        const bool after = dx > 0 || (dx == 0 && dy > 0);
-        const auto lo = std::lower_bound(
-            keys.begin() + (after ? long(first) : 0), keys.end(), k0);
-        const auto hi = std::upper_bound(lo, keys.end(), k0 + 4);
-        ranges[nr][0] = size_t(lo - keys.begin());
-        ranges[nr][1] = size_t(hi - keys.begin());
-        if (ranges[nr][0] < ranges[nr][1])
-          ++nr;
-      }
-    size_t candidates = 0;
-    for (int c = 0; c < nr; ++c)
-      candidates += ranges[c][1] - ranges[c][0];
-    if (found.size() < candidates)
-      found.resize(candidates);
-    // About half of the candidates lie within r. Where that is many
-    // times kMaxNeighbours, every stride-th candidate is looked at, an
-    // even subset from the start.
-    const size_t stride =
-        std::max<size_t>(1, candidates / (4 * kMaxNeighbours));
-    for (size_t q = first; q < last; ++q) {
-      // Every candidate is written, and kept (k advances) when within r:
-      // no branch to mispredict.
-      size_t k = 0, skip = 0;
-      for (int c = 0; c < nr; ++c) {
-        size_t o = ranges[c][0] + skip;
-        for (; o < ranges[c][1]; o += stride) {
-          const double dx = xs[o] - xs[q], dy = ys[o] - ys[q],
-                       dz = zs[o] - zs[q];
-          found[k] = uint32_t(o);
-          k += dx * dx + dy * dy + dz * dz < r2;
+  nb.count.assign(n, 0);
+  nb.list.reset(new uint32_t[n * kMaxNeighbours]);
+  // A block starts its first cell where the block starts: a point's
+  // neighbours depend on its cell only.
+  for_blocks(n, threads, progress, 0, 0.4, [&](size_t begin, size_t end) {
+    std::vector<uint32_t> found;
+    size_t ranges[21][2];
+    for (size_t first = begin; first < end;) {
+      const uint64_t key = keys[first];
+      size_t last = first;
+      while (last < end && keys[last] == key)
+        ++last;
+      const uint64_t cx = key >> 42, cy = (key >> 21) & kAxis;
+      int nr = 0;
+      for (int dx = -2; dx <= 2; ++dx)
+        for (int dy = -2; dy <= 2; ++dy) {
+          if ((dx == -2 || dx == 2) && (dy == -2 || dy == 2))
+            continue;
+          const uint64_t k0 = (uint64_t(int64_t(cx) + dx) << 42) |
+                              (uint64_t(int64_t(cy) + dy) << 21) |
+                              ((key & kAxis) - 2);
+          // Columns after this cell's start after the points of it.
+          const bool after = dx > 0 || (dx == 0 && dy > 0);
+          const auto lo = std::lower_bound(
+              keys.begin() + (after ? long(first) : 0), keys.end(), k0);
+          const auto hi = std::upper_bound(lo, keys.end(), k0 + 4);
+          ranges[nr][0] = size_t(lo - keys.begin());
+          ranges[nr][1] = size_t(hi - keys.begin());
+          if (ranges[nr][0] < ranges[nr][1])
+            ++nr;
         }
-        skip = o - ranges[c][1];
+      size_t candidates = 0;
+      for (int c = 0; c < nr; ++c)
+        candidates += ranges[c][1] - ranges[c][0];
+      if (found.size() < candidates)
+        found.resize(candidates);
+      // About half of the candidates lie within r. Where that is many
+      // times kMaxNeighbours, every stride-th candidate is looked at, an
+      // even subset from the start.
+      const size_t stride =
+          std::max<size_t>(1, candidates / (4 * kMaxNeighbours));
+      for (size_t q = first; q < last; ++q) {
+        // Every candidate is written, and kept (k advances) when within
+        // r: no branch to mispredict.
+        size_t k = 0, skip = 0;
+        for (int c = 0; c < nr; ++c) {
+          size_t o = ranges[c][0] + skip;
+          for (; o < ranges[c][1]; o += stride) {
+            const double dx = xs[o] - xs[q], dy = ys[o] - ys[q],
+                         dz = zs[o] - zs[q];
+            found[k] = uint32_t(o);
+            k += dx * dx + dy * dy + dz * dz < r2;
+          }
+          skip = o - ranges[c][1];
+        }
+        // Where more lie within r (dense overlaps, a large scale), an
+        // even subset of them: every (k / kMaxNeighbours)-th in the order
+        // of the cells, which spreads it over the ball.
+        uint32_t *out = &nb.list[q * kMaxNeighbours];
+        if (k > kMaxNeighbours) {
+          for (size_t j = 0; j < kMaxNeighbours; ++j)
+            out[j] = found[j * k / kMaxNeighbours];
+          k = kMaxNeighbours;
+        } else {
+          std::copy(found.begin(), found.begin() + long(k), out);
+        }
+        nb.count[q] = uint8_t(k);
       }
-      // Where more lie within r (dense overlaps, a large scale), an even
-      // subset of them: every (k / kMaxNeighbours)-th in the order of the
-      // cells, which spreads it over the ball.
-      if (k > kMaxNeighbours) {
-        for (size_t j = 0; j < kMaxNeighbours; ++j)
-          nb.list.push_back(found[j * k / kMaxNeighbours]);
-      } else {
-        nb.list.insert(nb.list.end(), found.begin(), found.begin() + long(k));
-      }
-      nb.first[q + 1] = nb.list.size();
+      first = last;
     }
-    progress.tick(first, 2 * n, 1u << 12);
-    first = last;
-  }
+  });
 }
 
 // The weight of a neighbour at squared distance d2 from a point, for the
@@ -522,14 +549,15 @@ inline double weight(double d2, double inv) {
 
 // Each point's unit normal: that of its neighbours' weighted plane.
 void plane_normals(const Neighbourhoods &nb, const std::vector<double> &cur,
-                   size_t n, double r, std::vector<double> &normals) {
+                   size_t begin, size_t end, double r,
+                   std::vector<double> &normals) {
   const double inv = 1.0 / (r * r);
-  normals.assign(3 * n, 0.0);
-  for (size_t q = 0; q < n; ++q) {
+  for (size_t q = begin; q < end; ++q) {
     const double *p = &cur[3 * q];
+    const uint32_t *list = nb.of(q);
     Moments m;
-    for (size_t j = nb.first[q]; j < nb.first[q + 1]; ++j) {
-      const double *y = &cur[3 * size_t(nb.list[j])];
+    for (size_t j = 0; j < nb.count[q]; ++j) {
+      const double *y = &cur[3 * size_t(list[j])];
       const double dx = y[0] - p[0], dy = y[1] - p[1], dz = y[2] - p[2];
       m.add(dx, dy, dz, weight(dx * dx + dy * dy + dz * dz, inv));
     }
@@ -545,10 +573,10 @@ void plane_normals(const Neighbourhoods &nb, const std::vector<double> &cur,
 // the new point. The plane alone would pull the points of a curved surface
 // inward (section 16.3).
 void project_step(const Neighbourhoods &nb, const std::vector<double> &cur,
-                  size_t n, double r, std::vector<double> &normals,
-                  std::vector<double> &next) {
+                  size_t begin, size_t end, double r,
+                  std::vector<double> &normals, std::vector<double> &next) {
   const double inv = 1.0 / (r * r), hs = 1.0 / r;
-  for (size_t q = 0; q < n; ++q) {
+  for (size_t q = begin; q < end; ++q) {
     const double *p = &cur[3 * q];
     double *nq = &normals[3 * q];
     Eigen::Vector3d t1, t2;
@@ -557,14 +585,15 @@ void project_step(const Neighbourhoods &nb, const std::vector<double> &cur,
     // r), w along the normal, and their weights.
     double u[kMaxNeighbours], v[kMaxNeighbours], w[kMaxNeighbours],
         wt[kMaxNeighbours];
-    size_t k = 0;
-    for (size_t j = nb.first[q]; j < nb.first[q + 1]; ++j, ++k) {
-      const double *y = &cur[3 * size_t(nb.list[j])];
+    const uint32_t *list = nb.of(q);
+    const size_t k = nb.count[q];
+    for (size_t j = 0; j < k; ++j) {
+      const double *y = &cur[3 * size_t(list[j])];
       const double dx = y[0] - p[0], dy = y[1] - p[1], dz = y[2] - p[2];
-      u[k] = (dx * t1[0] + dy * t1[1] + dz * t1[2]) * hs;
-      v[k] = (dx * t2[0] + dy * t2[1] + dz * t2[2]) * hs;
-      w[k] = dx * nq[0] + dy * nq[1] + dz * nq[2];
-      wt[k] = weight(dx * dx + dy * dy + dz * dz, inv);
+      u[j] = (dx * t1[0] + dy * t1[1] + dz * t1[2]) * hs;
+      v[j] = (dx * t2[0] + dy * t2[1] + dz * t2[2]) * hs;
+      w[j] = dx * nq[0] + dy * nq[1] + dz * nq[2];
+      wt[j] = weight(dx * dx + dy * dy + dz * dz, inv);
     }
     Quadric fit;
     fit.add(u, v, w, wt, k);
@@ -588,7 +617,7 @@ void project_step(const Neighbourhoods &nb, const std::vector<double> &cur,
 } // namespace
 
 Smoothing smooth(const double *xyz, size_t n, double scale,
-                 const NoiseEstimate &e, Progress &progress,
+                 const NoiseEstimate &e, unsigned threads, Progress &progress,
                  std::vector<double> &out) {
   Smoothing done;
   done.scale = scale;
@@ -596,16 +625,22 @@ Smoothing smooth(const double *xyz, size_t n, double scale,
   if (n < kMinPoints || !(e.spacing > 0) || !(scale > 0))
     return done;
   Neighbourhoods nb;
-  find_neighbours(xyz, n, scale, progress, nb);
-  // The points in the grid's order, smoothed there, then put back.
-  std::vector<double> cur(3 * n), next(3 * n), normals;
+  find_neighbours(xyz, n, scale, threads, progress, nb);
+  // The points in the grid's order, smoothed there, then put back. Each
+  // step reads cur and writes a point's own entries of next and normals.
+  std::vector<double> cur(3 * n), next(3 * n), normals(3 * n, 0.0);
   for (size_t q = 0; q < n; ++q)
     std::memcpy(&cur[3 * q], &xyz[3 * size_t(nb.order[q])], 3 * sizeof(double));
-  plane_normals(nb, cur, n, scale, normals);
+  for_blocks(n, threads, progress, 0.4, 0.5, [&](size_t begin, size_t end) {
+    plane_normals(nb, cur, begin, end, scale, normals);
+  });
   for (int it = 0; it < kIterations; ++it) {
-    project_step(nb, cur, n, scale, normals, next);
+    const double from = 0.5 + 0.5 * double(it) / kIterations;
+    for_blocks(n, threads, progress, from, from + 0.5 / kIterations,
+               [&](size_t begin, size_t end) {
+                 project_step(nb, cur, begin, end, scale, normals, next);
+               });
     cur.swap(next);
-    progress.report(0.5 + 0.5 * double(it + 1) / kIterations);
   }
   double sum = 0;
   for (size_t q = 0; q < n; ++q) {

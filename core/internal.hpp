@@ -301,9 +301,10 @@ struct Smoothing {
 };
 // Scale-space smoothing (after Digne et al. 2011): out receives a copy of
 // the points, each moved a few times onto the weighted least-squares
-// quadric of its neighbours within `scale`.
+// quadric of its neighbours within `scale`; on `threads` threads, with the
+// same result on any number.
 Smoothing smooth(const double *xyz, size_t n, double scale,
-                 const NoiseEstimate &e, Progress &progress,
+                 const NoiseEstimate &e, unsigned threads, Progress &progress,
                  std::vector<double> &out);
 
 namespace dt {

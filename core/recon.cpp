@@ -285,7 +285,8 @@ void Recon::prepare(Progress &progress) {
       (params_.mode == SC_MODE_AUTO && noisy)) {
     const double scale = params_.denoise_scale > 0 ? params_.denoise_scale
                                                    : default_scale(noise_);
-    smoothing_ = smooth(base, n_, scale, noise_, progress, smoothed_);
+    smoothing_ =
+        smooth(base, n_, scale, noise_, thread_count(), progress, smoothed_);
     work_ = smoothed_.data();
     dt_.reset(); // the raw points inserted so far
     dt_raw_ = false;

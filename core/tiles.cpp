@@ -8,20 +8,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 
 #include "delaunay.hpp"
+#include "parallel.hpp"
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <cstring>
-#include <exception>
-#include <mutex>
 #include <numeric>
 #include <string>
-#include <thread>
 
 namespace sc {
 namespace dt {
@@ -430,68 +427,6 @@ inline bool in_box(const Box &box, const double *p) {
     if (!(p[a] >= box.lo[a] && p[a] <= box.hi[a]))
       return false;
   return true;
-}
-
-// Runs fn(i, progress) for every tile i on `threads` threads while this
-// thread reports progress (done tiles of all) and watches for a cancel: a
-// cancel, or an error on any thread, stops the others at their next
-// progress tick, and is rethrown here once they have all stopped.
-template <class F>
-void run_tiles(size_t k, unsigned threads, Progress &progress, F &&fn) {
-  std::atomic<size_t> next{0}, done{0};
-  std::atomic<int> stop{0};
-  std::exception_ptr error;
-  std::mutex mu;
-  std::condition_variable cv;
-  auto worker = [&] {
-    Progress mine(
-        [](void *u, sc_stage_t, double) {
-          return static_cast<std::atomic<int> *>(u)->load();
-        },
-        &stop);
-    for (;;) {
-      const size_t i = next++;
-      if (i >= k || stop.load())
-        break;
-      try {
-        fn(i, mine);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mu);
-        if (!error)
-          error = std::current_exception();
-        stop = 1;
-      }
-      {
-        std::lock_guard<std::mutex> lock(mu);
-        ++done;
-      }
-      cv.notify_all();
-    }
-  };
-  threads = unsigned(std::max<size_t>(1, std::min<size_t>(threads, k)));
-  std::vector<std::thread> pool;
-  pool.reserve(threads);
-  std::exception_ptr cancelled;
-  try {
-    for (unsigned t = 0; t < threads; ++t)
-      pool.emplace_back(worker);
-    std::unique_lock<std::mutex> lock(mu);
-    while (done.load() < k && !stop.load()) {
-      cv.wait_for(lock, std::chrono::milliseconds(50));
-      lock.unlock();
-      progress.report(double(done.load()) / double(k));
-      lock.lock();
-    }
-  } catch (...) {
-    cancelled = std::current_exception();
-    stop = 1;
-  }
-  for (std::thread &t : pool)
-    t.join();
-  if (cancelled)
-    std::rethrow_exception(cancelled);
-  if (error)
-    std::rethrow_exception(error);
 }
 
 // Phase 1: a tile's own points, triangulated (vertices carry input
@@ -1287,8 +1222,9 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
   if (bounded) {
     distinct_points(xyz, n, is_vertex, out.dups);
   } else {
-    run_tiles(k, threads, progress,
-              [&](size_t i, Progress &p) { triangulate_own(xyz, ts[i], p); });
+    run_parallel(k, threads, progress, [&](size_t i, Progress &p) {
+      triangulate_own(xyz, ts[i], p);
+    });
     for (Tile &t : ts) {
       for (auto v = t.dt.finite_vertices_begin();
            v != t.dt.finite_vertices_end(); ++v)
@@ -1354,7 +1290,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
     // set and drops the triangulation; the second triangulates the same
     // vertices again (the same cells: they are certified) and tests its
     // facets once every pole is known.
-    run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
+    run_parallel(k, threads, progress, [&](size_t i, Progress &p) {
       Tile &t = ts[i];
       if (!grow(t, p))
         return;
@@ -1371,7 +1307,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
       return false;
     seconds[SC_STAGE_DELAUNAY] += sw.lap();
     progress.stage(SC_STAGE_CANDIDATES);
-    run_tiles(k, threads, progress, [&](size_t i, Progress &p) {
+    run_parallel(k, threads, progress, [&](size_t i, Progress &p) {
       Tile &t = ts[i];
       std::sort(t.vertices.begin(), t.vertices.end());
       triangulate_vertices(pts.data(), t.vertices, t, p);
@@ -1382,8 +1318,8 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
     });
   } else {
     try {
-      run_tiles(k, threads, progress,
-                [&](size_t i, Progress &p) { (void)grow(ts[i], p); });
+      run_parallel(k, threads, progress,
+                   [&](size_t i, Progress &p) { (void)grow(ts[i], p); });
     } catch (const NotTileable &e) {
       diag.tile_points_foreign = e.foreign;
       return false;
@@ -1392,12 +1328,12 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
       return false;
     seconds[SC_STAGE_DELAUNAY] += sw.lap();
     progress.stage(SC_STAGE_POLES);
-    run_tiles(k, threads, progress,
-              [&](size_t i, Progress &p) { poles(ts[i], p, ts[i].diag); });
+    run_parallel(k, threads, progress,
+                 [&](size_t i, Progress &p) { poles(ts[i], p, ts[i].diag); });
     seconds[SC_STAGE_POLES] += sw.lap();
     progress.stage(SC_STAGE_CANDIDATES);
-    run_tiles(k, threads, progress,
-              [&](size_t i, Progress &p) { candidates(ts[i], p); });
+    run_parallel(k, threads, progress,
+                 [&](size_t i, Progress &p) { candidates(ts[i], p); });
   }
 
   size_t total = 0;

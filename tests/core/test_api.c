@@ -76,6 +76,13 @@ typedef struct {
   int regress; /* stage went backwards, or fraction out of [0, 1] */
 } progress_t;
 
+/* Cancels once the input stage is past a fraction (smoothing's
+ * iterations, with --denoise). */
+static int cancel_late_input(void *user, sc_stage_t stage, double fraction) {
+  (void)user;
+  return stage == SC_STAGE_INPUT && fraction > 0.6;
+}
+
 static int on_progress(void *user, sc_stage_t stage, double fraction) {
   progress_t *p = user;
   ++p->calls;
@@ -263,6 +270,17 @@ int main(void) {
     EXPECT_NULL(m);
     EXPECT_EQ(pr.last_stage, s);
   }
+
+  /* Smoothing on 3 threads stops when cancelled in its iterations. */
+  sc_params_t sm = p;
+  sm.denoise = 1;
+  sm.denoise_scale = 0.15;
+  sm.threads = 3;
+  sm.progress = cancel_late_input;
+  m = (sc_mesh_t *)&m;
+  EXPECT_EQ(sc_reconstruct(xyz, N, &sm, &m, msg, sizeof msg), SC_ECANCELLED);
+  EXPECT_NULL(m);
+  EXPECT(strstr(msg, "input") != NULL);
 
   /* The allocator hint is taken by glibc's own malloc (the sanitizers
    * bring theirs) and changes nothing in the result. */

@@ -83,6 +83,8 @@ int main(int argc, char **argv) {
   p.mode = (sc_mode_t)mode;
   p.denoise = mode != SC_MODE_AUTO;
   p.smoothed_vertices = 1;
+  /* One thread here; more below, for the same smoothing. */
+  p.threads = 1;
   char msg[256];
   sc_mesh_t *m = NULL;
   ASSERT_EQ(sc_reconstruct(xyz, n, &p, &m, msg, sizeof msg), 0);
@@ -113,9 +115,10 @@ int main(int argc, char **argv) {
            sqrt(before / n) / spacing, sqrt(after / n) / spacing);
     EXPECT_LT(sqrt(after / n), 0.5 * sqrt(before / n));
 
-    /* The same triangles without the smoothed positions. */
+    /* The same triangles without the smoothed positions, on 3 threads. */
     sc_params_t q = p;
     q.smoothed_vertices = 0;
+    q.threads = 3;
     sc_mesh_t *m2 = NULL;
     ASSERT_EQ(sc_reconstruct(xyz, n, &q, &m2, msg, sizeof msg), 0);
     EXPECT_NULL(m2->smoothed);
@@ -124,7 +127,10 @@ int main(int argc, char **argv) {
                   3 * m->triangle_count * sizeof *m->triangles) == 0);
     sc_mesh_free(m2);
 
-    /* Streamed in chunks, the same mesh. */
+    /* Streamed in chunks on 2 threads, the same mesh and the same
+     * smoothed positions. */
+    q = p;
+    q.threads = 2;
     sc_recon_t *r = NULL;
     ASSERT_EQ(sc_recon_new(&q, &r), 0);
     for (size_t at = 0; at < n; at += 777)
@@ -137,6 +143,8 @@ int main(int argc, char **argv) {
     EXPECT(m3 && m3->triangle_count == m->triangle_count &&
            memcmp(m3->triangles, m->triangles,
                   3 * m->triangle_count * sizeof *m->triangles) == 0);
+    EXPECT(m3 && m3->smoothed &&
+           memcmp(m3->smoothed, m->smoothed, 3 * n * sizeof *m->smoothed) == 0);
     sc_mesh_free(m3);
   } else {
     /* Nothing to smooth: the mesh without denoising, no positions. */

@@ -4,7 +4,8 @@
  * counts of one triangulation, in the cocone and shortcrust modes, on a
  * synthetic sample, a real scan, a grid (cospherical everywhere, flat hull
  * faces) and a very uneven density; a cancel during the tiles stops them
- * all; the modes that run one triangulation say so (tiles 0). Each tile
+ * all; the modes that run one triangulation say so (tiles 0); points
+ * smoothed on two threads are smoothed as on one. Each tile
  * run as a job of its own (tile_count, tile_index) and merged
  * (sc_reconstruct_merge()) gives the same, and results that cannot be one
  * job's tiles are refused.
@@ -26,6 +27,19 @@
 #include "shortcrust_files.h"
 #include "synth.h"
 
+static sc_mesh_t *run_with(const char *what, const double *xyz, size_t n,
+                           const sc_params_t *p) {
+  sc_mesh_t *mesh = NULL;
+  char msg[256] = "";
+  int rc = sc_reconstruct(xyz, n, p, &mesh, msg, sizeof msg);
+  if (rc != 0) {
+    EXPECT_FAIL("%s, %s, %d tiles: %s: %s", what, sc_mode_name(p->mode),
+                p->tiles, sc_err_name(rc), msg);
+    return NULL;
+  }
+  return mesh;
+}
+
 static sc_mesh_t *run(const char *what, const double *xyz, size_t n,
                       sc_mode_t mode, int tiles, int threads) {
   sc_params_t p;
@@ -33,15 +47,7 @@ static sc_mesh_t *run(const char *what, const double *xyz, size_t n,
   p.mode = mode;
   p.tiles = tiles;
   p.threads = threads;
-  sc_mesh_t *mesh = NULL;
-  char msg[256] = "";
-  int rc = sc_reconstruct(xyz, n, &p, &mesh, msg, sizeof msg);
-  if (rc != 0) {
-    EXPECT_FAIL("%s, %s, %d tiles: %s: %s", what, sc_mode_name(mode), tiles,
-                sc_err_name(rc), msg);
-    return NULL;
-  }
-  return mesh;
+  return run_with(what, xyz, n, &p);
 }
 
 /* The tiled mesh must be the single triangulation's, array for array. */
@@ -161,6 +167,24 @@ int main(int argc, char **argv) {
     sc_mesh_t *t = run("torus", xyz, n + dups, SC_MODE_COCONE, 2, 2);
     if (one && t)
       same("torus", one, t, 2, 2);
+    sc_mesh_free(one);
+    sc_mesh_free(t);
+    /* Smoothed on two threads (section 16), then in two tiles: the mesh
+     * of one thread and one triangulation. */
+    sc_params_t p;
+    sc_params_init(&p);
+    p.denoise = 1;
+    p.denoise_scale = 0.15;
+    p.tiles = 1;
+    p.threads = 1;
+    one = run_with("smoothed torus", xyz, n + dups, &p);
+    p.tiles = 2;
+    p.threads = 2;
+    t = run_with("smoothed torus", xyz, n + dups, &p);
+    if (one && t) {
+      EXPECT(one->diag.denoised && t->diag.denoised);
+      same("smoothed torus", one, t, 2, 2);
+    }
     sc_mesh_free(one);
     sc_mesh_free(t);
     goto cancel;
