@@ -3,6 +3,14 @@
 // beside them, on real point files; prints one Markdown table.
 //
 //   shortcrust-modes-table DATA_DIR [FILE ...]
+//   shortcrust-modes-table --closed DATA_DIR [FILE ...]
+//
+// --closed is the table of closed models (the vertex sets of closed meshes,
+// NAME_points.ply beside NAME_gt_mesh.ply): the modes meant for closed
+// surfaces, each row with the components and genus of the ground truth
+// and whether the output is that surface (closed, every sample used, the
+// same components and genus), and a count of the models each method gets
+// right.
 //
 // FILE names a point file in DATA_DIR without its .ply extension; the
 // default is the list below. For each file and method: triangles, samples
@@ -25,15 +33,19 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include <dirent.h>
+#include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #ifdef __GLIBC__
@@ -126,21 +138,37 @@ double median_spacing(const std::vector<Point> &pts) {
   return nn.empty() ? 1 : nn[nn.size() / 2];
 }
 
-void row(const char *file, const char *method, const char *path, size_t points,
-         const uint32_t *t, size_t nt, const double *xyz, const Reference *ref,
-         double spacing, double seconds, double dt_seconds) {
-  scs_meshcheck_t c;
-  if (scs_meshcheck(points, xyz, t, nt, nullptr, &c) != 0) {
-    std::printf("| %s | %s | meshcheck failed |\n", file, method);
-    return;
-  }
-  // Genus summed over the components, open ones included (a component with
-  // boundary has genus (2 - chi - b) / 2), so that handles show whether or
-  // not the surface is closed.
+// Genus summed over the components, open ones included (a component with
+// boundary has genus (2 - chi - b) / 2), so that handles show whether or
+// not the surface is closed.
+long long genus_sum(const scs_meshcheck_t &c) {
   long long genus = 0;
   for (size_t i = 0; i < c.component_count; ++i)
     if (c.comp[i].genus > 0)
       genus += c.comp[i].genus;
+  return genus;
+}
+
+// The topology a closed model's output must have: the ground truth's.
+struct Expected {
+  bool known = false;
+  uint64_t components = 0;
+  long long genus = 0;
+};
+
+// Prints one row; true when the output is the expected closed surface
+// (closed, at least 99.9% of the samples used, the expected components
+// and genus).
+bool row(const char *file, const char *method, const char *path, size_t points,
+         const uint32_t *t, size_t nt, const double *xyz, const Reference *ref,
+         double spacing, double seconds, double dt_seconds,
+         const Expected *expected = nullptr) {
+  scs_meshcheck_t c;
+  if (scs_meshcheck(points, xyz, t, nt, nullptr, &c) != 0) {
+    std::printf("| %s | %s | meshcheck failed |\n", file, method);
+    return false;
+  }
+  const long long genus = genus_sum(c);
   char dist[64] = "-";
   if (ref) {
     double rms, max;
@@ -150,20 +178,37 @@ void row(const char *file, const char *method, const char *path, size_t points,
   }
   std::printf(
       "| %s | %s | %s | %zu | %.2f%% | %llu / %llu | %llu | %llu | "
-      "%llu | %s | %lld | %s | %.2f s | %.2f |\n",
+      "%llu | %s | %lld | %s | %.2f s | %.2f |",
       file, method, path, nt, 100.0 * double(c.vertices_used) / double(points),
       (unsigned long long)c.nonmanifold_edges,
       (unsigned long long)c.nonmanifold_vertices,
       (unsigned long long)c.orientation_errors,
       (unsigned long long)c.boundary_loops, (unsigned long long)c.components,
       c.closed ? "yes" : "no", genus, dist, seconds, seconds / dt_seconds);
+  bool right = false;
+  if (expected) {
+    right = expected->known && c.closed &&
+            double(c.vertices_used) >= 0.999 * double(points) &&
+            c.components == expected->components && genus == expected->genus;
+    if (expected->known)
+      std::printf(" %llu / %lld | %s |\n",
+                  (unsigned long long)expected->components, expected->genus,
+                  right ? "yes" : "**no**");
+    else
+      std::printf(" - | - |\n");
+  } else {
+    std::printf("\n");
+  }
   std::fflush(stdout);
   scs_meshcheck_free(&c);
+  return right;
 }
 
-// Measures one file and prints its rows; 0 on success.
+// Measures one file and prints its rows; 0 on success. With `closed`, the
+// closed models' methods and columns, and right[m] counts the models
+// method m got right (the advancing front last).
 int measure(const std::string &dir, const std::string &name, int repeat,
-            bool afsr) {
+            bool afsr, bool closed, int *right) {
   // (Rounds: see main(). A file of a few hundred points takes a
   // millisecond, so small files get rounds until the yardstick has taken
   // kMinYardstick seconds.)
@@ -176,12 +221,17 @@ int measure(const std::string &dir, const std::string &name, int repeat,
     int denoise;
     const char *name;
   };
-  const Method methods[] = {{SC_MODE_COCONE, 0, "cocone"},
-                            {SC_MODE_BOUNDARY, 0, "boundary"},
-                            {SC_MODE_WATERTIGHT, 0, "watertight"},
-                            {SC_MODE_AUTO, 0, "auto"},
-                            {SC_MODE_BOUNDARY, 1, "boundary --denoise"},
-                            {SC_MODE_WATERTIGHT, 1, "watertight --denoise"}};
+  const Method scans[] = {{SC_MODE_COCONE, 0, "cocone"},
+                          {SC_MODE_BOUNDARY, 0, "boundary"},
+                          {SC_MODE_WATERTIGHT, 0, "watertight"},
+                          {SC_MODE_AUTO, 0, "auto"},
+                          {SC_MODE_BOUNDARY, 1, "boundary --denoise"},
+                          {SC_MODE_WATERTIGHT, 1, "watertight --denoise"}};
+  const Method models[] = {{SC_MODE_COCONE, 0, "cocone"},
+                           {SC_MODE_SHORTCRUST, 0, "shortcrust"},
+                           {SC_MODE_WATERTIGHT, 0, "watertight"},
+                           {SC_MODE_AUTO, 0, "auto"}};
+  const Method *methods = closed ? models : scans;
   char msg[512];
   scf_points_t pts;
   std::string path = dir + "/" + name + ".ply";
@@ -196,7 +246,7 @@ int measure(const std::string &dir, const std::string &name, int repeat,
 
   // The yardstick, CGAL's Delaunay triangulation of the same points
   // inserted as a range, and every mode, in rounds.
-  const size_t nmodes = sizeof methods / sizeof methods[0];
+  const size_t nmodes = closed ? std::size(models) : std::size(scans);
   double t0 = 0, dt_seconds = HUGE_VAL, dt_total = 0;
   std::vector<double> best(nmodes, HUGE_VAL);
   std::vector<sc_mesh_t *> meshes(nmodes, nullptr);
@@ -236,9 +286,17 @@ int measure(const std::string &dir, const std::string &name, int repeat,
 
   // The ground truth, where there is one.
   std::unique_ptr<Reference> ref;
-  std::string gt = name.rfind("bunny", 0) == 0         ? "bunny_gt_mesh"
-                   : name.rfind("cgal_kitten", 0) == 0 ? "kitten_gt_mesh"
-                                                       : "";
+  // NAME_points.ply has NAME_gt_mesh.ply beside it.
+  const std::string suffix = "_points";
+  const bool points_file =
+      name.size() > suffix.size() &&
+      name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  std::string gt =
+      points_file ? name.substr(0, name.size() - suffix.size()) + "_gt_mesh"
+      : name.rfind("bunny", 0) == 0       ? "bunny_gt_mesh"
+      : name.rfind("cgal_kitten", 0) == 0 ? "kitten_gt_mesh"
+                                          : "";
+  Expected expected;
   if (!gt.empty()) {
     scf_points_t gp;
     uint32_t *gt_tri = nullptr;
@@ -257,6 +315,14 @@ int measure(const std::string &dir, const std::string &name, int repeat,
       }
       ref->tree = std::make_unique<Tree>(ref->tris.begin(), ref->tris.end());
       ref->tree->accelerate_distance_queries();
+      scs_meshcheck_t c;
+      if (scs_meshcheck(gp.count, gp.xyz, gt_tri, gnt, nullptr, &c) == 0 &&
+          c.closed) {
+        expected.known = true;
+        expected.components = c.components;
+        expected.genus = genus_sum(c);
+      }
+      scs_meshcheck_free(&c);
       std::free(gt_tri);
       scf_points_free(&gp);
     } else {
@@ -271,9 +337,11 @@ int measure(const std::string &dir, const std::string &name, int repeat,
       continue;
     }
     const sc_mesh_t *mesh = meshes[m];
-    row(name.c_str(), methods[m].name, sc_path_name(mesh->diag.path), pts.count,
-        mesh->triangles, mesh->triangle_count, pts.xyz, ref.get(), spacing,
-        best[m], dt_seconds);
+    if (row(name.c_str(), methods[m].name, sc_path_name(mesh->diag.path),
+            pts.count, mesh->triangles, mesh->triangle_count, pts.xyz,
+            ref.get(), spacing, best[m], dt_seconds,
+            closed ? &expected : nullptr))
+      ++right[m];
     sc_mesh_free(meshes[m]);
   }
 
@@ -292,8 +360,10 @@ int measure(const std::string &dir, const std::string &name, int repeat,
   for (const auto &f : facets)
     for (int k = 0; k < 3; ++k)
       t.push_back(uint32_t(f[k]));
-  row(name.c_str(), "CGAL AFSR", "-", pts.count, t.data(), facets.size(),
-      pts.xyz, ref.get(), spacing, sec, dt_seconds);
+  if (row(name.c_str(), "CGAL AFSR", "-", pts.count, t.data(), facets.size(),
+          pts.xyz, ref.get(), spacing, sec, dt_seconds,
+          closed ? &expected : nullptr))
+    ++right[nmodes];
   scf_points_free(&pts);
   return 0;
 }
@@ -304,11 +374,17 @@ int main(int argc, char **argv) {
   // As the command line does: freed memory is kept for reuse (and
   // cold_heap() gives it back before every timed run).
   (void)sc_tune_allocator();
+  bool closed = argc >= 2 && std::strcmp(argv[1], "--closed") == 0;
+  if (closed) {
+    --argc;
+    ++argv;
+  }
   if (argc < 2 || argv[1][0] == '-') {
     bool help = argc >= 2 && (std::strcmp(argv[1], "--help") == 0 ||
                               std::strcmp(argv[1], "-h") == 0);
     std::fprintf(help ? stdout : stderr,
-                 "usage: %s DATA_DIR [--repeat N] [--no-afsr] [FILE ...]\n\n"
+                 "usage: %s [--closed] DATA_DIR [--repeat N] [--no-afsr] "
+                 "[FILE ...]\n\n"
                  "Runs every mode (boundary and watertight also with --denoise)"
                  "\nand CGAL's advancing front on the point "
                  "files\nDATA_DIR/FILE.ply (default: the bunny scans, "
@@ -319,7 +395,14 @@ int main(int argc, char **argv) {
                  "has\ntaken 0.25 s in all), each round running the "
                  "construction and then\nevery mode, so that all see the "
                  "same load. The advancing front\nruns once; --no-afsr "
-                 "leaves it out (it takes minutes on the\nmerged scans).\n",
+                 "leaves it out (it takes minutes on the\nmerged scans).\n\n"
+                 "--closed: the closed models, FILE_points.ply beside their\n"
+                 "FILE_gt_mesh.ply (default: every such pair in DATA_DIR),\n"
+                 "in the modes for closed surfaces, each row with the\n"
+                 "ground truth's components and genus and whether the "
+                 "output is\nthat surface (closed, 99.9%% of the samples "
+                 "used, the same\ncomponents and genus), and a count of "
+                 "the models each method\ngets right.\n",
                  argv[0]);
     return help ? 0 : 2;
   }
@@ -344,6 +427,25 @@ int main(int argc, char **argv) {
       files.push_back(argv[i]);
     }
   }
+  if (files.empty() && closed) {
+    // Every NAME_points.ply with its NAME_gt_mesh.ply, in name order.
+    std::unique_ptr<DIR, int (*)(DIR *)> d(opendir(dir.c_str()), closedir);
+    if (!d) {
+      std::fprintf(stderr, "%s: %s\n", dir.c_str(), std::strerror(errno));
+      return 2;
+    }
+    const std::string tail = "_points.ply";
+    while (const dirent *e = readdir(d.get())) {
+      const std::string f = e->d_name;
+      if (f.size() <= tail.size() ||
+          f.compare(f.size() - tail.size(), tail.size(), tail) != 0)
+        continue;
+      const std::string base = f.substr(0, f.size() - tail.size());
+      if (access((dir + "/" + base + "_gt_mesh.ply").c_str(), R_OK) == 0)
+        files.push_back(base + "_points");
+    }
+    std::sort(files.begin(), files.end());
+  }
   if (files.empty())
     files = {"bunny_points",         "bunny_rawscan_bun000",
              "bunny_rawscan_bun045", "bunny_rawscans_merged10",
@@ -353,8 +455,20 @@ int main(int argc, char **argv) {
               "non-manifold edges / vertices | orientation errors | "
               "boundary loops | components | closed | genus (sum) | "
               "distance to GT, RMS / max (spacings) | time | time / CGAL "
-              "Delaunay |\n");
-  std::printf("|---|---|---|--:|--:|--:|--:|--:|--:|---|---|--:|--:|--:|\n");
+              "Delaunay |%s\n",
+              closed ? " expected components / genus | right |" : "");
+  std::printf("|---|---|---|--:|--:|--:|--:|--:|--:|---|---|--:|--:|--:|%s\n",
+              closed ? "--:|---|" : "");
+  // The models each method got right, counted by the measuring processes.
+  constexpr size_t kMethods = 5;
+  int *right = static_cast<int *>(mmap(nullptr, kMethods * sizeof(int),
+                                       PROT_READ | PROT_WRITE,
+                                       MAP_SHARED | MAP_ANONYMOUS, -1, 0));
+  if (right == MAP_FAILED) {
+    std::perror("mmap");
+    return 1;
+  }
+  std::fill(right, right + kMethods, 0);
   for (const std::string &name : files) {
     // Each file in a process of its own: one that follows a larger file
     // would find the heap that file left (pages of it stay mapped however
@@ -367,7 +481,7 @@ int main(int argc, char **argv) {
       return 1;
     }
     if (pid == 0) {
-      const int rc = measure(dir, name, repeat, afsr);
+      const int rc = measure(dir, name, repeat, afsr, closed, right);
       std::fflush(stdout);
       std::_Exit(rc);
     }
@@ -378,5 +492,18 @@ int main(int argc, char **argv) {
       return 1;
     }
   }
+  if (closed) {
+    const char *names[kMethods] = {"cocone", "shortcrust", "watertight", "auto",
+                                   "CGAL AFSR"};
+    std::printf("\nRight (closed, >= 99.9%% of the samples, the ground "
+                "truth's components and genus), of %zu models:",
+                files.size());
+    for (size_t m = 0; m < kMethods; ++m)
+      if (m + 1 < kMethods || afsr)
+        std::printf(" %s %d%s", names[m], right[m],
+                    m + 1 < kMethods && (m + 2 < kMethods || afsr) ? "," : "");
+    std::printf("\n");
+  }
+  munmap(right, kMethods * sizeof(int));
   return 0;
 }
