@@ -1,9 +1,10 @@
 /*
- * Real scans shipped in tests/data: closed 2-manifolds of the known genus,
- * consistently oriented outward, with (almost) every sample a vertex, in
- * the default mode or the one named.
+ * Real scans and the vertex sets of closed models shipped in tests/data:
+ * closed 2-manifolds of the known genus, consistently oriented outward,
+ * with (almost) every sample a vertex, in the default mode or the one
+ * named.
  *
- *   test_core_realdata FILE GENUS [cocone|watertight]
+ *   test_core_realdata FILE GENUS [cocone|watertight|auto]
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -19,7 +20,7 @@
 
 int main(int argc, char **argv) {
   if (argc != 3 && argc != 4) {
-    fprintf(stderr, "usage: %s FILE GENUS [cocone|watertight]\n", argv[0]);
+    fprintf(stderr, "usage: %s FILE GENUS [cocone|watertight|auto]\n", argv[0]);
     return 2;
   }
   sc_params_t p;
@@ -29,6 +30,8 @@ int main(int argc, char **argv) {
       p.mode = SC_MODE_COCONE;
     } else if (strcmp(argv[3], "watertight") == 0) {
       p.mode = SC_MODE_WATERTIGHT;
+    } else if (strcmp(argv[3], "auto") == 0) {
+      p.mode = SC_MODE_AUTO;
     } else {
       fprintf(stderr, "unknown mode '%s'\n", argv[3]);
       return 2;
