@@ -34,17 +34,20 @@ std::vector<uint32_t> by_decreasing_x(const double *xyz, size_t n,
 }
 
 // The walk: grow each component from a seed triangle, crossing every edge
-// to the first triangle met when rotating about it from the outer side.
+// to the first triangle met when rotating about it from the outer side,
+// breadth or depth first (docs/algorithm.md section 8).
 // A triangle joins only if it keeps every directed edge used at most once
 // (edge-manifold, consistently oriented) and touches no vertex of an
 // earlier component.
 class Walk {
 public:
   Walk(const double *xyz, size_t n, const std::vector<uint32_t> &live,
-       const EdgeTable &et, const VertexStar &star, Progress &progress)
+       const EdgeTable &et, const VertexStar &star, bool breadth_first,
+       Progress &progress)
       : otri(live), in(live.size() / 3, 0), xyz_(xyz), live_(live), et_(et),
         star_(star), progress_(progress), nl_(live.size() / 3),
-        used_(et.edges(), 0), owner_(n, -1), etri_(et.entries.size()) {
+        used_(et.edges(), 0), owner_(n, -1), etri_(et.entries.size()),
+        breadth_first_(breadth_first) {
     // The triangles of the edge table alone, side by side: the walk reads
     // little else of an entry, at every edge it crosses.
     for (size_t i = 0; i < etri_.size(); ++i)
@@ -172,11 +175,20 @@ private:
     if (!try_add(seed, a, b, c, comp))
       return;
     members_.push_back(seed);
-    queue_.assign(1, seed);
-    while (!queue_.empty()) {
+    // Breadth first, the triangles taken are the queue: members_[next ..).
+    // Depth first, a stack of its own.
+    size_t next = 0;
+    if (!breadth_first_)
+      stack_.assign(1, seed);
+    while (breadth_first_ ? next < members_.size() : !stack_.empty()) {
       progress_.tick(++added_, 2 * nl_);
-      uint32_t t = queue_.back();
-      queue_.pop_back();
+      uint32_t t;
+      if (breadth_first_) {
+        t = members_[next++];
+      } else {
+        t = stack_.back();
+        stack_.pop_back();
+      }
       for (int k = 0; k < 3; ++k) {
         uint32_t x = otri[3 * size_t(t) + k],
                  y = otri[3 * size_t(t) + (k + 1) % 3];
@@ -199,7 +211,8 @@ private:
                                               : w[2];
         if (try_add(nb, y, x, z, comp)) {
           members_.push_back(nb);
-          queue_.push_back(nb);
+          if (!breadth_first_)
+            stack_.push_back(nb);
         }
       }
     }
@@ -236,7 +249,8 @@ private:
   std::vector<uint8_t> used_;  // per edge: the directions used (dir_bit())
   std::vector<int32_t> owner_; // per vertex: its component, or -1
   std::vector<uint32_t> etri_;
-  std::vector<uint32_t> members_, queue_;
+  const bool breadth_first_;
+  std::vector<uint32_t> members_, stack_;
   size_t added_ = 0;
 };
 
@@ -245,8 +259,8 @@ private:
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, EdgeTablePtr table,
              size_t max_hole, const std::vector<uint8_t> &boundary,
-             Progress &progress, Surface &out, sc_diag_t &diag,
-             bool check_vertices) {
+             bool breadth_first, Progress &progress, Surface &out,
+             sc_diag_t &diag, bool check_vertices) {
   const size_t nt = cand.size() / 3;
   // Only the survivors of pruning take part.
   std::vector<uint32_t> live;
@@ -260,7 +274,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   star.build(n, live, [](size_t) { return true; });
 
   const std::vector<uint32_t> order = by_decreasing_x(xyz, n, star);
-  Walk walk(xyz, n, live, et, star, progress);
+  Walk walk(xyz, n, live, et, star, breadth_first, progress);
   walk.run(order);
   std::vector<uint32_t> &otri = walk.otri;
   std::vector<uint8_t> &in = walk.in;

@@ -188,14 +188,15 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
            Progress &progress, sc_diag_t &diag);
 // The walk and small holes (sections 8 and 9). Takes the table prune()
 // left for the same candidates and alive flags. Holes mostly rimmed by
-// samples marked in boundary are left open.
+// samples marked in boundary are left open. The walk grows breadth first
+// or depth first (section 8).
 // `check_vertices` as in describe(): pass false only when an open surface
 // will be described again before it is output.
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, EdgeTablePtr table,
              size_t max_hole, const std::vector<uint8_t> &boundary,
-             Progress &progress, Surface &out, sc_diag_t &diag,
-             bool check_vertices = true);
+             bool breadth_first, Progress &progress, Surface &out,
+             sc_diag_t &diag, bool check_vertices = true);
 // The topology of a finished surface (section 10): components, boundary loops,
 // genus, manifold checks; closed components facing inward are flipped. Resets
 // and fills the output fields of diag (triangles, boundary, components ...).

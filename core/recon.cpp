@@ -583,9 +583,12 @@ sc_mesh_t *Recon::finish() {
   const bool scan_holes = watertight && !f.boundary.empty();
   // Watertight mode describes an open surface again once it is closed,
   // and checks its vertices then (fix_fans_in() leaves one fan at each).
+  // The walk grows breadth first where no boundary is detected; the
+  // boundary modes keep the depth-first walk that watertight mode's handle
+  // cutting was measured on (section 8).
   extract(lxyz.data(), m, f.tris, alive, std::move(table),
           scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary,
-          progress, surf, diag, !watertight);
+          !detects_boundary(params_.mode), progress, surf, diag, !watertight);
   if (detects_boundary(params_.mode)) {
     // Real scans: overlapping layers leave bubbles, small closed components
     // between them, and samples the walk passed by. Drop the bubbles;
