@@ -583,12 +583,15 @@ sc_mesh_t *Recon::finish() {
   const bool scan_holes = watertight && !f.boundary.empty();
   // Watertight mode describes an open surface again once it is closed,
   // and checks its vertices then (fix_fans_in() leaves one fan at each).
-  // The walk grows breadth first where no boundary is detected; the
-  // boundary modes keep the depth-first walk that watertight mode's handle
-  // cutting was measured on (section 8).
+  // The walk grows breadth first, but where boundary samples were found
+  // it keeps the depth-first order that watertight mode's handle cutting
+  // was measured on (section 8). So a boundary mode that finds none runs
+  // exactly the cocone mode.
   extract(lxyz.data(), m, f.tris, alive, std::move(table),
           scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary,
-          !detects_boundary(params_.mode), progress, surf, diag, !watertight);
+          std::none_of(f.boundary.begin(), f.boundary.end(),
+                       [](uint8_t b) { return b != 0; }),
+          progress, surf, diag, !watertight);
   if (detects_boundary(params_.mode)) {
     // Real scans: overlapping layers leave bubbles, small closed components
     // between them, and samples the walk passed by. Drop the bubbles;
