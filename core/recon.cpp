@@ -589,9 +589,7 @@ sc_mesh_t *Recon::finish() {
   // exactly the cocone mode.
   extract(lxyz.data(), m, f.tris, alive, std::move(table),
           scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary,
-          std::none_of(f.boundary.begin(), f.boundary.end(),
-                       [](uint8_t b) { return b != 0; }),
-          progress, surf, diag, !watertight);
+          diag.boundary_samples == 0, progress, surf, diag, !watertight);
   if (detects_boundary(params_.mode)) {
     // Real scans: overlapping layers leave bubbles, small closed components
     // between them, and samples the walk passed by. Drop the bubbles;

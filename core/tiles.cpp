@@ -780,8 +780,9 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own,
 // closed surface: the inner balls of a sphere's sample hold nearly all of
 // it), a tile takes in most of the others' points, and the tiles would
 // cost many times one triangulation of all. With `give_up`, a tile that
-// takes in more than kMostForeign times its own points throws
-// NotTileable.
+// takes in more than kMostForeign times its own points, or whose
+// certification costs more than kMostWork leaves of the tree a point it
+// owns, throws NotTileable.
 //
 // A tile job (tile_job()) runs alone: nothing gives it the poles of the
 // foreign vertices of the facets it tests. With `ring`, a second round
