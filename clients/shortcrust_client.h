@@ -243,7 +243,8 @@ typedef struct sc_client_params {
    * parameter table (SC_PARAM_MAP in shortcrust.h) that travels as an
    * option, with that row's name, type, range and meaning, in its order:
    * today paper_pruning, max_hole_edges, boundary_rho (in (0, 10]),
-   * boundary_alpha (in (0, pi/2] radians), watertight_labels, denoise,
+   * boundary_alpha (in (0, pi/2] radians), watertight_labels,
+   * watertight_patches, denoise,
    * denoise_scale and smoothed_vertices (the mesh's vertices, below). Each is
    * sent only when not left at its "daemon's default" value, which
    * sc_client_params_init() sets: -1 for an integer, 0 for a number or a

@@ -69,11 +69,9 @@ enum : uint8_t {
 // Once the candidates are chosen the circumcentre is not needed any more,
 // and watertight mode reuses its bytes for the cell's label.
 struct CellLabel {
-  uint32_t local;      // scratch: the cell's place in a vertex's star
-  uint16_t vin, vout;  // surface triangles that put the cell inside, outside
-  uint8_t label;       // kUnlabelled, kInside, kOutside
-  uint8_t barrier;     // bit f: facet f is a surface triangle
-  uint8_t moved;       // relabelled once already: stays as it is now
+  uint32_t local; // scratch: the cell's number, or place in a vertex's star
+  uint8_t label;  // kUnlabelled, kInside, kOutside
+  uint8_t moved;  // times the repair moved it
 };
 enum : uint8_t { kUnlabelled = 0, kInside = 1, kOutside = 2 };
 // Boundary detection ignores, for the extent of a cell in the cocone, a

@@ -377,10 +377,13 @@ private:
   // How far each tile holds the points beyond its region from the start.
   double tile_margin() const { return 3 * noise_.spacing; }
   void insert_range(const double *xyz, size_t first, size_t n);
-  // Watertight mode: closes surf; first cuts the handles that closed round
-  // holes of the scan when `cut`.
+  // Watertight mode: closes surf, by labelling the Delaunay cells or by
+  // least-area patches; before the patches, cuts the handles that closed
+  // round holes of the scan when `cut`.
   void close_surface(const double *lxyz, size_t m, bool cut,
                      Progress &progress, Surface &surf, sc_diag_t &diag);
+  void patch_surface(const double *lxyz, size_t m, bool cut, Progress &progress,
+                     Surface &surf, sc_diag_t &diag);
   // Denoising (section 16): whether insertion waits for finish(); the
   // estimate and the smoothing, which set work_ (xyz_, or smoothed_).
   bool defer_insertion() const;

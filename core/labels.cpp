@@ -1,13 +1,15 @@
 // Watertight mode's closure by labels: every Delaunay cell is labelled
-// inside or outside across the oriented surface, and the boundary of the
-// inside cells, repaired into a manifold, replaces the surface.
+// inside or outside by the shape of the empty balls, and the boundary of
+// the inside cells, repaired into a manifold, replaces the surface.
 //
 // SPDX-License-Identifier: GPL-3.0-or-later
 
 #include "delaunay.hpp"
 
 #include <array>
+#include <cmath>
 #include <numeric>
+#include <queue>
 
 namespace sc {
 namespace dt {
@@ -21,20 +23,10 @@ public:
 
   explicit Labelling(DT &t) : dt_(t) {}
 
-  // Watertight mode: label every cell inside or outside across the
-  // oriented surface and take the boundary of the inside cells.
-  //  - Seeds: the cell behind an outward triangle is inside, the one in
-  //    front outside (a cell that several triangles touch takes the
-  //    majority); infinite cells are outside.
-  //  - A multi-source breadth-first search through the facets that are not
-  //    surface triangles labels the rest, so that the inside and outside
-  //    fronts meet in the middle of each hole.
-  //  - The boundary of the union of the inside cells is closed, but may
-  //    touch itself at an edge or a vertex. Around each vertex the cells of
-  //    each label must form one piece (joined across facets at the vertex);
-  //    that also rules out pinched edges. Where they do not, the smallest
-  //    offending piece moves to the other label, and the neighbours are
-  //    checked again.
+  // Watertight mode: label every cell inside or outside by the shape of
+  // the empty balls (weigh()), repair the boundary of the inside cells
+  // into a manifold and put it in tris. Returns false, leaving tris as it
+  // was, when no cell is inside.
   bool label_and_close(std::vector<uint32_t> &tris, Progress &progress,
                        sc_diag_t &diag) {
     const size_t m = dt_.number_of_vertices();
@@ -43,24 +35,12 @@ public:
          ++v)
       vh_[v->info().idx] = v;
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
-      c->info().w = CellLabel{0, 0, 0, kUnlabelled, 0, 0};
-
-    // Open components may come out of extraction facing inward; the hull
-    // tells: a triangle on the hull must face the infinite cell. Flip a
-    // component whose hull triangles mostly face inward.
-    const size_t nt = tris.size() / 3;
-    std::vector<Ch> fc(nt);
-    std::vector<int8_t> fi(nt, -1);
-    std::vector<int8_t> hull_vote(nt, 0);
-    find_facets(tris, progress, fc, fi, hull_vote);
-    flip_inward_components(tris, hull_vote);
-
-    std::vector<Ch> queue = seed(tris, fc, fi);
-    progress.tick(nt, 4 * nt + 1);
-    spread(std::move(queue));
-    progress.tick(2 * nt, 4 * nt + 1);
+      c->info().w = CellLabel{0, kUnlabelled, 0};
+    progress.tick(0, 3);
+    weigh(progress);
+    progress.tick(1, 3);
     repair(diag);
-    progress.tick(3 * nt, 4 * nt + 1);
+    progress.tick(2, 3);
     std::vector<uint32_t> res = boundary_of_inside();
     if (res.empty())
       return false;
@@ -69,91 +49,283 @@ public:
   }
 
 private:
-  // The Delaunay facet of each surface triangle t, as cell fc[t] and its
-  // facet fi[t] (-1 for a triangle that is not a facet), and the vote of
-  // each hull triangle on its orientation (see flip_inward_components()).
-  void find_facets(const std::vector<uint32_t> &tris, Progress &progress,
-                   std::vector<Ch> &fc, std::vector<int8_t> &fi,
-                   std::vector<int8_t> &hull_vote) {
-    const size_t nt = tris.size() / 3;
-    for (size_t t = 0; t < nt; ++t) {
-      progress.tick(t, 4 * nt + 1);
-      const uint32_t *v = &tris[3 * t];
-      int i, j, l;
-      Ch c;
-      if (!dt_.is_facet(vh_[v[0]], vh_[v[1]], vh_[v[2]], c, i, j, l))
-        continue; // a hole-filling triangle: not a Delaunay facet
-      int f = 6 - i - j - l;
-      fc[t] = c;
-      fi[t] = int8_t(f);
-      Ch nb = c->neighbor(f);
-      bool c_front = in_front(v, c, f);
-      if (dt_.is_infinite(c))
-        hull_vote[t] = c_front ? 1 : -1;
-      else if (dt_.is_infinite(nb))
-        hull_vote[t] = c_front ? -1 : 1;
-    }
-  }
-
-  // The seeds: the votes of the surface triangles on the cells on either
-  // side of them, which they also bar from each other; returns the cells
-  // labelled, infinite ones included.
-  std::vector<Ch> seed(const std::vector<uint32_t> &tris,
-                       const std::vector<Ch> &fc,
-                       const std::vector<int8_t> &fi) {
-    const size_t nt = tris.size() / 3;
-    std::vector<Ch> queue;
-    for (size_t t = 0; t < nt; ++t) {
-      if (fi[t] < 0)
-        continue;
-      Ch c = fc[t], nb = c->neighbor(fi[t]);
-      bool c_front = in_front(&tris[3 * t], c, fi[t]);
-      vote(c, c_front ? kOutside : kInside);
-      vote(nb, c_front ? kInside : kOutside);
-      c->info().w.barrier |= uint8_t(1u << fi[t]);
-      nb->info().w.barrier |= uint8_t(1u << nb->index(c));
-    }
+  // The labelling of the power crust (Amenta, Choi and Kolluri 2001), on
+  // the Delaunay cells: every cell's circumscribing ball is empty, and the
+  // balls of a closed surface's inside and outside meet it at a shallow
+  // angle from either side, while balls on one side overlap deeply.
+  //  - The infinite cells are outside.
+  //  - A labelled cell tells each neighbour across a facet to take its
+  //    label, with the weight -cos of the angle at which their spheres
+  //    cross (1 where one ball holds the other's circle deep inside, up to
+  //    0 where they cross at right angles; shallower crossings tell
+  //    nothing). The outer half-space of a hull facet is the infinite
+  //    cell's ball.
+  //  - The two poles of a sample (section 4.2) lie on either side of the
+  //    surface: a labelled pole tells the sample's other pole to take the
+  //    other label, with the weight -cos of the angle between them at the
+  //    sample. A sample on the hull has the outside as its first pole.
+  //  - The cell with the clearest evidence is labelled next: the larger of
+  //    its two weights where it has only one, and their difference less one
+  //    where it has both, so that conflicting cells wait. Ties go by the
+  //    cells' vertex numbers, not their places in memory.
+  // A cell no weight reaches stays outside.
+  void weigh(Progress &progress) {
+    std::vector<Ch> cells;
+    cells.reserve(dt_.number_of_cells() + dt_.number_of_finite_cells());
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
-      CellLabel &w = c->info().w;
-      if (dt_.is_infinite(c))
-        w.label = kOutside;
-      else if (w.vin || w.vout)
-        w.label = w.vin > w.vout ? kInside : kOutside;
-      if (w.label != kUnlabelled)
-        queue.push_back(c);
+      c->info().w.local = uint32_t(cells.size());
+      cells.push_back(c);
     }
-    return queue;
-  }
+    const size_t n = cells.size();
+    // Circumcentres and squared radii; r2 < 0 marks an infinite cell.
+    std::vector<Ball> ball(n);
+    for (size_t i = 0; i < n; ++i) {
+      Ch c = cells[i];
+      if (dt_.is_infinite(c)) {
+        ball[i].r2 = -1;
+        continue;
+      }
+      const Point o =
+          CGAL::circumcenter(c->vertex(0)->point(), c->vertex(1)->point(),
+                             c->vertex(2)->point(), c->vertex(3)->point());
+      ball[i] = Ball{{o.x(), o.y(), o.z()},
+                     CGAL::squared_distance(o, c->vertex(0)->point())};
+    }
+    progress.tick(0, 3);
+    find_poles(cells, ball);
 
-  // Labels the rest from the cells in queue, across every facet that is not
-  // a surface triangle. Level by level, so that the result does not depend
-  // on the order of the cells in memory: a cell reached from the last level
-  // takes the label of most of its neighbours there (outside on a tie),
-  // counted in w.local (inside in the high half).
-  void spread(std::vector<Ch> queue) {
-    std::vector<Ch> next;
-    while (!queue.empty()) {
-      next.clear();
-      for (Ch c : queue) {
-        const CellLabel w = c->info().w;
-        for (int f = 0; f < 4; ++f) {
-          if (w.barrier & (1u << f))
-            continue;
-          CellLabel &v = c->neighbor(f)->info().w;
-          if (v.label != kUnlabelled)
-            continue;
-          if (v.local == 0)
-            next.push_back(c->neighbor(f));
-          v.local += w.label == kInside ? 1u << 16 : 1u;
+    std::vector<float> ein(n, 0), eout(n, 0);
+    std::vector<uint8_t> lab(n, kUnlabelled);
+    auto priority = [&](size_t i) {
+      const float a = ein[i], b = eout[i];
+      return a > 0 && b > 0 ? std::fabs(a - b) - 1 : std::max(a, b);
+    };
+    struct Entry {
+      float prio;
+      uint32_t cell;
+    };
+    auto later = [&](const Entry &a, const Entry &b) {
+      if (a.prio != b.prio)
+        return a.prio < b.prio;
+      return cell_key(cells[a.cell]) > cell_key(cells[b.cell]);
+    };
+    std::priority_queue<Entry, std::vector<Entry>, decltype(later)> queue(
+        later);
+    for (size_t i = 0; i < n; ++i)
+      if (ball[i].r2 < 0) {
+        eout[i] = 2; // above any weight
+        queue.push(Entry{2, uint32_t(i)});
+      }
+    // Samples on the hull: the outside is their first pole.
+    for (size_t v = 0; v < poles_.size(); ++v)
+      if (poles_[v].hull && poles_[v].second != kNone) {
+        const uint32_t q = poles_[v].second;
+        const float w =
+            float(-cos_at(vh_[v]->point(), poles_[v].dir, ball[q].o));
+        if (w > ein[q]) {
+          ein[q] = w;
+          queue.push(Entry{priority(q), q});
         }
       }
-      for (Ch c : next) {
-        CellLabel &w = c->info().w;
-        w.label = (w.local >> 16) > (w.local & 0xFFFFu) ? kInside : kOutside;
-        w.local = 0;
+
+    size_t done = 0;
+    while (!queue.empty()) {
+      const Entry e = queue.top();
+      queue.pop();
+      const uint32_t i = e.cell;
+      if (lab[i] != kUnlabelled || e.prio != priority(i))
+        continue; // labelled already, or its evidence has grown since
+      if ((++done & 0xFFFF) == 0)
+        progress.tick(1, 3);
+      lab[i] = ein[i] > eout[i] ? kInside : kOutside;
+      const bool in = lab[i] == kInside;
+      Ch c = cells[i];
+      for (int f = 0; f < 4; ++f) {
+        const uint32_t j = c->neighbor(f)->info().w.local;
+        if (lab[j] != kUnlabelled)
+          continue;
+        const float w = float(-crossing(c, f, ball));
+        float &same = in ? ein[j] : eout[j];
+        if (w > same) {
+          same = w;
+          queue.push(Entry{priority(j), j});
+        }
       }
-      queue.swap(next);
+      if (ball[i].r2 < 0)
+        continue;
+      for (int k = 0; k < 4; ++k) {
+        const uint32_t v = c->vertex(k)->info().idx;
+        const Poles &p = poles_[v];
+        const uint32_t q = p.first == i    ? p.second
+                           : p.second == i ? p.first
+                                           : kNone;
+        if (q == kNone || lab[q] != kUnlabelled)
+          continue;
+        const Point &s = vh_[v]->point();
+        const double a[3] = {ball[i].o[0] - s.x(), ball[i].o[1] - s.y(),
+                             ball[i].o[2] - s.z()};
+        const float w = float(-cos_at(s, a, ball[q].o));
+        float &other = in ? eout[q] : ein[q];
+        if (w > other) {
+          other = w;
+          queue.push(Entry{priority(q), q});
+        }
+      }
     }
+    for (size_t i = 0; i < n; ++i) {
+      CellLabel &w = cells[i]->info().w;
+      w.label = lab[i] == kInside ? kInside : kOutside;
+      w.local = 0;
+    }
+    poles_ = std::vector<Poles>();
+  }
+
+  struct Ball {
+    double o[3];
+    double r2; // squared radius; negative for an infinite cell
+  };
+  static constexpr uint32_t kNone = UINT32_MAX;
+  // A sample's poles: the cells of its farthest circumcentre (first) and of
+  // the farthest on the other side (second); on the hull, the outside is
+  // the first (dir, the sum of the outward normals of its hull facets).
+  struct Poles {
+    uint32_t first = kNone, second = kNone;
+    bool hull = false;
+    double dir[3] = {0, 0, 0}; // from the sample toward the first pole
+    double far2 = -1;          // scratch: the farthest distance so far
+  };
+
+  // The poles of every sample (section 4.2), from the circumcentres, in two
+  // passes over the cells.
+  void find_poles(const std::vector<Ch> &cells, const std::vector<Ball> &ball) {
+    poles_.assign(vh_.size(), Poles());
+    for (size_t i = 0; i < cells.size(); ++i) {
+      Ch c = cells[i];
+      if (ball[i].r2 < 0) {
+        // A hull facet: its outward normal goes to its three samples.
+        const int k = c->index(dt_.infinite_vertex());
+        double nrm[3];
+        if (!outward_normal(c, k, nrm))
+          continue;
+        for (int j = 1; j < 4; ++j) {
+          Poles &p = poles_[c->vertex((k + j) % 4)->info().idx];
+          p.hull = true;
+          for (int a = 0; a < 3; ++a)
+            p.dir[a] += nrm[a];
+        }
+        continue;
+      }
+      for (int j = 0; j < 4; ++j) {
+        Poles &p = poles_[c->vertex(j)->info().idx];
+        const double d2 = dist2(c->vertex(j)->point(), ball[i].o);
+        if (d2 > p.far2) {
+          p.far2 = d2;
+          p.first = uint32_t(i);
+        }
+      }
+    }
+    for (size_t v = 0; v < poles_.size(); ++v) {
+      Poles &p = poles_[v];
+      if (p.hull) {
+        p.first = kNone;
+      } else if (p.first != kNone) {
+        const Point &s = vh_[v]->point();
+        const double *o = ball[p.first].o;
+        p.dir[0] = o[0] - s.x(), p.dir[1] = o[1] - s.y(),
+        p.dir[2] = o[2] - s.z();
+      }
+      p.far2 = -1;
+    }
+    for (size_t i = 0; i < cells.size(); ++i) {
+      if (ball[i].r2 < 0)
+        continue;
+      Ch c = cells[i];
+      for (int j = 0; j < 4; ++j) {
+        Poles &p = poles_[c->vertex(j)->info().idx];
+        const Point &s = c->vertex(j)->point();
+        const double *o = ball[i].o;
+        const double a[3] = {o[0] - s.x(), o[1] - s.y(), o[2] - s.z()};
+        if (a[0] * p.dir[0] + a[1] * p.dir[1] + a[2] * p.dir[2] >= 0)
+          continue;
+        const double d2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        if (d2 > p.far2) {
+          p.far2 = d2;
+          p.second = uint32_t(i);
+        }
+      }
+    }
+  }
+
+  // The unit normal of facet f of cell c, pointing away from c's vertex f
+  // (for an infinite cell, the hull facet's outward normal); false for a
+  // facet too small to tell.
+  bool outward_normal(Ch c, int f, double nrm[3]) const {
+    Ch in = c, out = c->neighbor(f);
+    int fi = f;
+    if (dt_.is_infinite(c->vertex(f))) { // look from the finite side
+      in = c->neighbor(f);
+      fi = in->index(c);
+      out = c;
+    }
+    (void)out;
+    const Point &a = in->vertex((fi + 1) % 4)->point();
+    const Point &b = in->vertex((fi + 2) % 4)->point();
+    const Point &d = in->vertex((fi + 3) % 4)->point();
+    K::Vector_3 n = CGAL::cross_product(b - a, d - a);
+    const double len = std::sqrt(n.squared_length());
+    if (!(len > 0))
+      return false;
+    if (n * (in->vertex(fi)->point() - a) > 0)
+      n = -n;
+    for (int k = 0; k < 3; ++k)
+      nrm[k] = n[k] / len;
+    return true;
+  }
+
+  // The cosine of the angle at which the spheres of cell c and of its
+  // neighbour across facet f cross: 1 where they only touch, -1 where one
+  // holds the other. For an infinite neighbour, its ball is the outer
+  // half-space of the hull facet.
+  double crossing(Ch c, int f, const std::vector<Ball> &ball) const {
+    Ch nb = c->neighbor(f);
+    const Ball &p = ball[c->info().w.local], &q = ball[nb->info().w.local];
+    if (p.r2 < 0 && q.r2 < 0)
+      return -1;
+    if (p.r2 < 0 || q.r2 < 0) {
+      // The finite cell's centre, h above the hull facet (outward): the
+      // crossing is at the angle whose cosine is -h / r.
+      Ch fin = p.r2 < 0 ? nb : c;
+      const Ball &b = p.r2 < 0 ? q : p;
+      const int fi = p.r2 < 0 ? nb->index(c) : f;
+      double nrm[3];
+      if (!outward_normal(fin, fi, nrm))
+        return 0;
+      const Point &a = fin->vertex((fi + 1) % 4)->point();
+      const double h = nrm[0] * (b.o[0] - a.x()) + nrm[1] * (b.o[1] - a.y()) +
+                       nrm[2] * (b.o[2] - a.z());
+      return std::max(-1.0, std::min(1.0, -h / std::sqrt(b.r2)));
+    }
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k)
+      d2 += (p.o[k] - q.o[k]) * (p.o[k] - q.o[k]);
+    const double den = 2 * std::sqrt(p.r2 * q.r2);
+    if (!(den > 0))
+      return 0;
+    return std::max(-1.0, std::min(1.0, (d2 - p.r2 - q.r2) / den));
+  }
+
+  static double dist2(const Point &s, const double o[3]) {
+    return (o[0] - s.x()) * (o[0] - s.x()) + (o[1] - s.y()) * (o[1] - s.y()) +
+           (o[2] - s.z()) * (o[2] - s.z());
+  }
+  // The cosine of the angle at sample s between direction a and point o.
+  static double cos_at(const Point &s, const double a[3], const double o[3]) {
+    const double b[3] = {o[0] - s.x(), o[1] - s.y(), o[2] - s.z()};
+    const double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    const double bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+    if (!(aa > 0 && bb > 0))
+      return 0;
+    return (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / std::sqrt(aa * bb);
   }
 
   // Repairs the pinches of the inside cells' boundary (see repair_vertex()).
@@ -182,12 +354,8 @@ private:
     // Rounds: a vertex at which no piece may move waits for the next round,
     // which allows more moves per cell.
     std::vector<Vh> unresolved, moved;
-    for (int round = 0; round < 6; ++round) {
-      // The first rounds leave the cells next to the surface where the
-      // surface put them, so that the repair reshapes the caps over the
-      // holes, not the surface; later rounds move any cell, more often.
-      const bool keep_seeds = round < 3;
-      const uint8_t max_moves = uint8_t(2 << (2 * (round % 3)));
+    for (int round = 0; round < 3; ++round) {
+      const uint8_t max_moves = uint8_t(2 << (2 * round));
       for (Vh v : unresolved)
         if (!queued[v->info().idx]) {
           queued[v->info().idx] = 1;
@@ -200,7 +368,7 @@ private:
         work.pop_back();
         queued[v->info().idx] = 0;
         moved.clear();
-        if (!repair_vertex(v, max_moves, keep_seeds, moved, diag))
+        if (!repair_vertex(v, max_moves, moved, diag))
           unresolved.push_back(v);
         std::sort(moved.begin(), moved.end(), [](Vh a, Vh b) {
           return a->info().idx < b->info().idx;
@@ -253,10 +421,9 @@ private:
   // which then takes the whole star and v leaves the surface), and appends
   // the vertices of the moved cells to `touched`. A piece that holds an
   // infinite cell, or a cell moved max_moves times already, stays, so the
-  // repair ends; so does one next to a surface triangle if keep_seeds.
-  // Returns false when no piece could move.
-  bool repair_vertex(Vh v, uint8_t max_moves, bool keep_seeds,
-                     std::vector<Vh> &touched, sc_diag_t &diag) {
+  // repair ends. Returns false when no piece could move.
+  bool repair_vertex(Vh v, uint8_t max_moves, std::vector<Vh> &touched,
+                     sc_diag_t &diag) {
     std::vector<Ch> &inc = star_;
     inc.clear();
     dt_.incident_cells(v, std::back_inserter(inc));
@@ -294,8 +461,7 @@ private:
       if (size[r]++ == 0)
         ++pieces[inc[r]->info().w.label];
       const CellLabel &w = inc[i]->info().w;
-      if (dt_.is_infinite(inc[i]) || w.moved >= max_moves ||
-          (keep_seeds && (w.vin || w.vout)))
+      if (dt_.is_infinite(inc[i]) || w.moved >= max_moves)
         fixed[r] = 1;
     }
     if (pieces[kInside] <= 1 && pieces[kOutside] <= 1)
@@ -337,63 +503,13 @@ private:
                              vh_[t[2]]->point(),
                              d->point()) == CGAL::POSITIVE;
   }
-  // Whether cell c lies in front of its facet f, the triangle t.
-  bool in_front(const uint32_t *t, Ch c, int f) const {
-    if (!dt_.is_infinite(c->vertex(f)))
-      return front(t, c->vertex(f));
-    Ch nb = c->neighbor(f);
-    return !front(t, nb->vertex(nb->index(c)));
-  }
-
-  // Flips every edge-connected component of tris whose votes (+1 for a
-  // hull triangle facing the infinite cell, -1 for one facing away) add up
-  // to less than zero.
-  static void flip_inward_components(std::vector<uint32_t> &tris,
-                                     const std::vector<int8_t> &votes) {
-    const size_t nt = tris.size() / 3;
-    std::vector<std::pair<uint64_t, uint32_t>> edges;
-    edges.reserve(3 * nt);
-    for (size_t t = 0; t < nt; ++t)
-      for (int k = 0; k < 3; ++k) {
-        uint64_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3];
-        edges.emplace_back(a < b ? (a << 32) | b : (b << 32) | a,
-                           uint32_t(t));
-      }
-    std::sort(edges.begin(), edges.end());
-    std::vector<uint32_t> parent(nt);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](uint32_t x) {
-      while (parent[x] != x)
-        x = parent[x] = parent[parent[x]];
-      return x;
-    };
-    for (size_t i = 1; i < edges.size(); ++i)
-      if (edges[i].first == edges[i - 1].first) {
-        uint32_t a = find(edges[i].second), b = find(edges[i - 1].second);
-        if (a != b)
-          parent[std::max(a, b)] = std::min(a, b);
-      }
-    std::vector<int64_t> score(nt, 0);
-    for (size_t t = 0; t < nt; ++t)
-      score[find(uint32_t(t))] += votes[t];
-    for (size_t t = 0; t < nt; ++t)
-      if (score[find(uint32_t(t))] < 0)
-        std::swap(tris[3 * t + 1], tris[3 * t + 2]);
-  }
-
-  void vote(Ch c, uint8_t label) {
-    CellLabel &w = c->info().w;
-    if (label == kInside && w.vin < UINT16_MAX)
-      ++w.vin;
-    if (label == kOutside && w.vout < UINT16_MAX)
-      ++w.vout;
-  }
 
 private:
   DT &dt_;
   std::vector<Vh> vh_; // vertex number -> handle
   std::vector<Ch> star_; // scratch of repair_vertex()
   std::vector<uint32_t> parent_, size_;
+  std::vector<Poles> poles_; // by vertex number, while weigh() runs
 };
 
 } // namespace

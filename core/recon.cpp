@@ -71,8 +71,10 @@ template <class T> T *copy_out(const T *src, size_t count) {
 }
 
 // What decides between two closures of a surface: a closed manifold first,
-// then fewer loops left open, the smaller genus, fewer components, more
-// samples.
+// then fewer loops left open, fewer components, the smaller genus, more
+// samples. (Components before genus: the labelling joins the thin parts
+// that extraction broke off, and the patches keep a single sheet from
+// closing into a thin slab that the labelling can pierce.)
 struct Closure {
   bool ok;
   int64_t genus;
@@ -86,10 +88,10 @@ struct Closure {
       return ok;
     if (loops != o.loops)
       return loops < o.loops;
-    if (genus != o.genus)
-      return genus < o.genus;
     if (components != o.components)
       return components < o.components;
+    if (genus != o.genus)
+      return genus < o.genus;
     return unused < o.unused;
   }
 };
@@ -97,27 +99,21 @@ struct Closure {
 } // namespace
 
 // Watertight mode, after extraction (docs/algorithm.md sections 11.2 to
-// 11.5): closes the open components of surf.
-// First the least-area patches over each loop, which keep the surface as
-// it is; if they leave a closed manifold, that is the result. Otherwise the
-// Delaunay cells are labelled across the surface, which closes holes of any
-// size, and the better of the two closures is kept (see Closure). On the
-// bunny scans the patches won every time, with a lower genus and in a
-// fraction of the time. Closed components take no part in the labelling
-// (two nested spheres would otherwise vote against each other) and are
-// added back as they are.
+// 11.5): closes surf, in two ways, and keeps the better (see Closure):
+//  - the least-area patches over the holes of the extracted surface, after
+//    cutting the handles that closed round a hole of a scan; they keep the
+//    extracted surface as it is;
+//  - the boundary of the inside cells, once the Delaunay cells are
+//    labelled inside or outside from their empty balls alone (section
+//    11.4). On the closed models measured it keeps thin parts in one piece
+//    where extraction broke them off, and leaves out the false handles
+//    that the candidates make across them.
+// watertight_labels takes the labelling alone (the patches only when no
+// cell comes out inside); watertight_patches labels only when the patches
+// leave the surface open.
 void Recon::close_surface(const double *lxyz, size_t m, bool cut,
                           Progress &progress, Surface &surf, sc_diag_t &diag) {
   const uint64_t loops = diag.boundary_loops, before = diag.triangles;
-  std::vector<uint32_t> open, closed_part;
-  for (size_t t = 0; t < surf.tris.size() / 3; ++t)
-    (surf.in_closed(t) ? closed_part : open)
-        .insert((surf.in_closed(t) ? closed_part : open).end(),
-                &surf.tris[3 * t], &surf.tris[3 * t] + 3);
-  if (open.empty()) {
-    diag.path = SC_PATH_WATERTIGHT;
-    return;
-  }
   // Debris, such as lone triangles between scan layers, cannot be closed:
   // small open components go (their samples may be attached later).
   auto drop_debris = [&](Surface &s, sc_diag_t &d) {
@@ -128,8 +124,85 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     }
   };
 
-  Surface b;
-  sc_diag_t db = diag;
+  // The closure by labels, into a and da; false when no cell is inside.
+  Surface a;
+  sc_diag_t da = diag;
+  auto label = [&] {
+    // The triangulation went after the candidates, for it is most of the
+    // memory: build it again over the same points, numbered as the
+    // surface's vertices are.
+    double box[6];
+    bounding_box(lxyz, m, box);
+    std::unique_ptr<Triangulator> dt = make_triangulator(params_.threads, box);
+    dt->insert(lxyz, 0, m, progress);
+    std::vector<uint32_t> labelled;
+    if (!dt->close(labelled, progress, da))
+      return false;
+    canonical_order(labelled, true);
+    describe(lxyz, m, labelled, progress, a, da);
+    if (da.nonmanifold_edges || da.nonmanifold_vertices) {
+      // Relabelling left a few pinches: cut them out and close the small
+      // holes that leaves.
+      drop_nonmanifold(lxyz, m, a.tris, progress);
+      fill_holes(lxyz, m, a.tris, kMaxFillLoop, {}, progress, da, kMaxFillWork);
+      describe(lxyz, m, a.tris, progress, a, da);
+    }
+    drop_debris(a, da);
+    return true;
+  };
+  auto take_labels = [&] {
+    const uint64_t relabelled = da.cells_relabelled;
+    surf = std::move(a);
+    diag = da;
+    diag.path = SC_PATH_WATERTIGHT;
+    diag.cells_relabelled = relabelled;
+  };
+
+  bool open = false;
+  for (size_t t = 0; t < surf.tris.size() / 3 && !open; ++t)
+    open = !surf.in_closed(t);
+  auto patch = [&] {
+    if (open) {
+      patch_surface(lxyz, m, cut, progress, surf, diag);
+      drop_debris(surf, diag);
+    } else {
+      diag.path = SC_PATH_WATERTIGHT; // nothing was open
+    }
+  };
+  const bool labels_only = params_.watertight_labels != 0;
+  const bool patches_first = !labels_only && params_.watertight_patches != 0;
+  if (!labels_only)
+    patch();
+  if ((labels_only || !patches_first || !Closure(diag).ok) && label()) {
+    if (labels_only || !Closure(diag).better_than(Closure(da)))
+      take_labels();
+  } else if (labels_only) {
+    patch(); // no cell came out inside
+  }
+  // Pockets: closing may leave small closed components inside the main one
+  // (the inside of a bubble, a cap that closed on itself). Those under a
+  // hundredth of the surface go; their samples may be attached later.
+  if (diag.components > 1) {
+    const uint64_t comps = diag.components;
+    drop_small_closed(lxyz, m, surf, surf.tris.size() / 3 / 100, false,
+                      progress, diag);
+    diag.bubbles_dropped += comps - std::min(comps, diag.components);
+  }
+  // Every loop of the extracted surface was closed if the result is.
+  diag.holes_filled = diag.closed ? loops : 0;
+  diag.hole_triangles = diag.triangles > before ? diag.triangles - before : 0;
+}
+
+// Watertight mode's least-area patches (sections 11.2 and 11.3) over the
+// open components of surf, after cutting the handles that closed round a
+// hole (with cut); the closed components stay as they are.
+void Recon::patch_surface(const double *lxyz, size_t m, bool cut,
+                          Progress &progress, Surface &surf, sc_diag_t &diag) {
+  std::vector<uint32_t> open, closed_part;
+  for (size_t t = 0; t < surf.tris.size() / 3; ++t)
+    (surf.in_closed(t) ? closed_part : open)
+        .insert((surf.in_closed(t) ? closed_part : open).end(),
+                &surf.tris[3 * t], &surf.tris[3 * t] + 3);
   // Handles that closed round a hole, where the scan has no samples, would
   // stay in any closure: cut them first (see cut_handles()).
   // A handle is genus: where every open component is a disc with holes
@@ -158,74 +231,13 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   // The surface was described after extraction, and cutting handles only
   // takes triangles out of open components: no component to flip, and
   // describe() runs once the holes are filled.
-  auto patch = [&] {
-    b.tris.swap(surf.tris);
-    fill_holes(lxyz, m, b.tris, kMaxFillLoop, {}, progress, db, kMaxFillWork,
-               table.get());
-    describe(lxyz, m, b.tris, progress, b, db, table.get());
-    table.reset(); // before the labelling's triangulation, if it comes
-    drop_debris(b, db);
-  };
-  const bool labels_first = params_.watertight_labels != 0;
-  if (!labels_first)
-    patch();
-
-  Surface a;
-  sc_diag_t da = diag;
-  bool have_labels = false;
-  if (labels_first || !Closure(db).ok) {
-    // The triangulation went after the candidates, for it is most of the
-    // memory (and the patches alone close every scan measured): build it
-    // again over the same points, numbered as the surface's vertices are.
-    double box[6];
-    bounding_box(lxyz, m, box);
-    std::unique_ptr<Triangulator> dt = make_triangulator(params_.threads, box);
-    dt->insert(lxyz, 0, m, progress);
-    std::vector<uint32_t> labelled = open;
-    have_labels = dt->close(labelled, progress, da);
-    canonical_order(labelled, true);
-    if (have_labels) {
-      labelled.insert(labelled.end(), closed_part.begin(), closed_part.end());
-      describe(lxyz, m, labelled, progress, a, da);
-      if (da.nonmanifold_edges || da.nonmanifold_vertices) {
-        // Relabelling left a few pinches: cut them out and close the small
-        // holes that leaves.
-        drop_nonmanifold(lxyz, m, a.tris, progress);
-        fill_holes(lxyz, m, a.tris, kMaxFillLoop, {}, progress, da,
-                 kMaxFillWork);
-        describe(lxyz, m, a.tris, progress, a, da);
-      }
-      drop_debris(a, da);
-    }
-  }
-  const uint64_t relabelled = da.cells_relabelled;
-  if (labels_first && !have_labels)
-    patch();
-
-  if (have_labels &&
-      (labels_first || !Closure(db).better_than(Closure(da)))) {
-    surf = std::move(a);
-    diag = da;
-    diag.path = SC_PATH_WATERTIGHT;
-  } else {
-    surf = std::move(b);
-    diag = db;
-    diag.path = SC_PATH_WATERTIGHT_FILL;
-  }
-  diag.cells_relabelled = relabelled;
+  std::vector<uint32_t> tris;
+  tris.swap(surf.tris);
+  fill_holes(lxyz, m, tris, kMaxFillLoop, {}, progress, diag, kMaxFillWork,
+             table.get());
+  describe(lxyz, m, tris, progress, surf, diag, table.get());
+  diag.path = SC_PATH_WATERTIGHT_FILL;
   diag.handles_cut = handles;
-  // Pockets: closing may leave small closed components inside the main one
-  // (the inside of a bubble, a cap that closed on itself). Those under a
-  // hundredth of the surface go; their samples may be attached later.
-  if (diag.components > 1) {
-    const uint64_t comps = diag.components;
-    drop_small_closed(lxyz, m, surf, surf.tris.size() / 3 / 100, false,
-                      progress, diag);
-    diag.bubbles_dropped += comps - std::min(comps, diag.components);
-  }
-  // Every loop of the extracted surface was closed if the result is.
-  diag.holes_filled = diag.closed ? loops : 0;
-  diag.hole_triangles = diag.triangles > before ? diag.triangles - before : 0;
 }
 
 // With --denoise the triangulation is built on the smoothed copy, which

@@ -199,11 +199,13 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    them, and only tile tile_index is computed; the result is not a mesh
  *    but what sc_reconstruct_merge() needs of that tile: see there.
  *    tile_count 0, the default, is the whole job.
- *  - watertight_labels: 0 closes the holes with least-area patches and
- *    labels the Delaunay cells only where the patches cannot close the
- *    surface; 1 labels the cells first (inside or outside across the
- *    surface; the output is the boundary of the inside cells) and patches
- *    only when no cell comes out inside.
+ *  - watertight_labels, watertight_patches: by default (and always with
+ *    watertight_labels 1) watertight mode labels the Delaunay cells inside
+ *    or outside by their empty balls, and the output is the boundary of the
+ *    inside cells; least-area patches close the holes of the extracted
+ *    surface only when no cell comes out inside. watertight_patches 1
+ *    (with watertight_labels 0) patches first, keeping the extracted
+ *    surface, and labels only where the patches cannot close it.
  */
 #define SC_RANGE_CLOSED 0      /* lo <= v <= hi */
 #define SC_RANGE_LO_OPEN 1     /* lo < v */
@@ -257,8 +259,11 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
   X(watertight_labels, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION,  \
     0, "labels", NULL,                                                         \
     "watertight mode: close the surface by labelling Delaunay cells inside "   \
-    "or outside first (default: least-area patches first, labelling where "    \
-    "they cannot close it)")                                                   \
+    "or outside (the default; overrides --patches)")                           \
+  X(watertight_patches, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION, \
+    0, "patches", NULL,                                                        \
+    "watertight mode: close the holes of the extracted surface with "          \
+    "least-area patches first, labelling cells only where they cannot")        \
   X(denoise, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION, 0,         \
     "denoise", NULL,                                                           \
     "smooth a copy of the points toward the surface and reconstruct on it; "   \
