@@ -427,9 +427,18 @@ private:
     std::vector<Ch> &inc = star_;
     inc.clear();
     dt_.incident_cells(v, std::back_inserter(inc));
-    // In an order that depends on the vertices only, not on the memory.
-    std::sort(inc.begin(), inc.end(),
-              [&](Ch a, Ch b) { return cell_key(a) < cell_key(b); });
+    // In an order that depends on the vertices only, not on the memory
+    // (each cell's key made once).
+    keyed_.clear();
+    for (Ch c : inc)
+      keyed_.emplace_back(cell_key(c), c);
+    std::sort(keyed_.begin(), keyed_.end(),
+              [](const std::pair<std::array<uint32_t, 4>, Ch> &a,
+                 const std::pair<std::array<uint32_t, 4>, Ch> &b) {
+                return a.first < b.first;
+              });
+    for (size_t i = 0; i < inc.size(); ++i)
+      inc[i] = keyed_[i].second;
     const size_t k = inc.size();
     for (size_t i = 0; i < k; ++i)
       inc[i]->info().w.local = uint32_t(i);
@@ -508,6 +517,7 @@ private:
   DT &dt_;
   std::vector<Vh> vh_; // vertex number -> handle
   std::vector<Ch> star_; // scratch of repair_vertex()
+  std::vector<std::pair<std::array<uint32_t, 4>, Ch>> keyed_; // likewise
   std::vector<uint32_t> parent_, size_;
   std::vector<Poles> poles_; // by vertex number, while weigh() runs
 };
