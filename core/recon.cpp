@@ -71,10 +71,12 @@ template <class T> T *copy_out(const T *src, size_t count) {
 }
 
 // What decides between two closures of a surface: a closed manifold first,
-// then fewer loops left open, fewer components, the smaller genus, more
-// samples. (Components before genus: the labelling joins the thin parts
-// that extraction broke off, and the patches keep a single sheet from
-// closing into a thin slab that the labelling can pierce.)
+// then fewer loops left open, fewer components, more samples in a
+// triangle, the smaller genus. (The labelling joins the thin parts that
+// extraction broke off, and passes through the samples that the walk left
+// out, where the patches close the holes without them; a single sheet,
+// which has no inside, closes by labelling into a thin slab in pieces
+// that also leaves out its rim, and the patches win.)
 struct Closure {
   bool ok;
   int64_t genus;
@@ -90,9 +92,9 @@ struct Closure {
       return loops < o.loops;
     if (components != o.components)
       return components < o.components;
-    if (genus != o.genus)
-      return genus < o.genus;
-    return unused < o.unused;
+    if (unused != o.unused)
+      return unused < o.unused;
+    return genus < o.genus;
   }
 };
 
