@@ -260,14 +260,12 @@ private:
   // (for an infinite cell, the hull facet's outward normal); false for a
   // facet too small to tell.
   bool outward_normal(Ch c, int f, double nrm[3]) const {
-    Ch in = c, out = c->neighbor(f);
+    Ch in = c;
     int fi = f;
     if (dt_.is_infinite(c->vertex(f))) { // look from the finite side
       in = c->neighbor(f);
       fi = in->index(c);
-      out = c;
     }
-    (void)out;
     const Point &a = in->vertex((fi + 1) % 4)->point();
     const Point &b = in->vertex((fi + 2) % 4)->point();
     const Point &d = in->vertex((fi + 3) % 4)->point();
