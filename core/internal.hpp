@@ -108,24 +108,25 @@ public:
                       Progress &progress) = 0;
   virtual int dimension() const = 0;
   // Resolves duplicates, then runs poles and candidates, filling diag.
-  // Frees the triangulation at the end.
+  // Frees the triangulation at the end, unless keep is set (for close()).
   virtual void filter(const double *xyz, size_t n, const sc_params_t &params,
                       Progress &progress, Filtered &out, sc_diag_t &diag,
                       double seconds[SC_STAGE_COUNT]) = 0;
-  // Watertight mode (section 11.4), on a triangulation of the surface's
-  // (distinct) points inserted in the order of its vertex numbers, without
-  // filter(): labels the cells inside or outside across the oriented
-  // surface tris (vertex numbers) and
-  // replaces tris by the boundary of the inside cells, repaired into a
-  // 2-manifold as far as relabelling goes (a few pinched vertices may be
-  // left). Returns false, leaving tris as it was, when no cell is inside.
-  // Frees the triangulation.
+  // Watertight mode (section 11.4), on the triangulation that filter()
+  // kept, or on one of the surface's (distinct) points inserted in the
+  // order of its vertex numbers, without filter(): labels the cells inside
+  // or outside and puts in tris (vertex numbers) the boundary of the inside
+  // cells, repaired into a 2-manifold as far as relabelling goes (a few
+  // pinched vertices may be left). Returns false, leaving tris as it was,
+  // when no cell is inside. Frees the triangulation.
   virtual bool close(std::vector<uint32_t> &tris, Progress &progress,
                      sc_diag_t &diag) = 0;
   // Moves every vertex by -shift; the caller makes sure each subtraction
   // is exact (recentre()), so the triangulation stays the Delaunay
   // triangulation of its points, cell for cell.
   virtual void translate(const double shift[3]) = 0;
+  // filter() keeps the triangulation for close() instead of freeing it.
+  bool keep = false;
 };
 
 // Section 3.4: sets shift to the lower corner of the points' box on each
@@ -409,6 +410,8 @@ private:
   Smoothing smoothing_;
   double seconds_denoise_ = 0;
   std::unique_ptr<Triangulator> dt_;
+  // Watertight mode: the triangulation filter() kept for the labelling.
+  std::unique_ptr<Triangulator> kept_;
   double seconds_[SC_STAGE_COUNT] = {};
   const sc_mesh_t *const *merge_ = nullptr;
   size_t merge_count_ = 0;

@@ -70,61 +70,61 @@ private:
   //    cells' vertex numbers, not their places in memory.
   // A cell no weight reaches stays outside.
   void weigh(Progress &progress) {
-    std::vector<Ch> cells;
-    cells.reserve(dt_.number_of_cells() + dt_.number_of_finite_cells());
-    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
-      c->info().w.local = uint32_t(cells.size());
-      cells.push_back(c);
-    }
-    const size_t n = cells.size();
-    // Circumcentres and squared radii; r2 < 0 marks an infinite cell.
+    // Cells are numbered in w.local for the arrays below, in memory order;
+    // nothing that decides a label depends on that order.
+    size_t n = 0;
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
+      c->info().w.local = uint32_t(n++);
+    // Circumcentres and squared radii, in single precision: they weigh
+    // evidence, and the cosines lose nothing that matters (the error is
+    // relative to the radii). r2 < 0 marks an infinite cell.
     std::vector<Ball> ball(n);
-    for (size_t i = 0; i < n; ++i) {
-      Ch c = cells[i];
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
+      Ball &b = ball[c->info().w.local];
       if (dt_.is_infinite(c)) {
-        ball[i].r2 = -1;
+        b.r2 = -1;
         continue;
       }
       const Point o =
           CGAL::circumcenter(c->vertex(0)->point(), c->vertex(1)->point(),
                              c->vertex(2)->point(), c->vertex(3)->point());
-      ball[i] = Ball{{o.x(), o.y(), o.z()},
-                     CGAL::squared_distance(o, c->vertex(0)->point())};
+      b = Ball{{float(o.x()), float(o.y()), float(o.z())},
+               float(CGAL::squared_distance(o, c->vertex(0)->point()))};
     }
     progress.tick(0, 3);
-    find_poles(cells, ball);
+    find_poles(ball);
 
     std::vector<float> ein(n, 0), eout(n, 0);
-    std::vector<uint8_t> lab(n, kUnlabelled);
     auto priority = [&](size_t i) {
       const float a = ein[i], b = eout[i];
       return a > 0 && b > 0 ? std::fabs(a - b) - 1 : std::max(a, b);
     };
     struct Entry {
       float prio;
-      uint32_t cell;
+      Ch cell;
     };
     auto later = [&](const Entry &a, const Entry &b) {
       if (a.prio != b.prio)
         return a.prio < b.prio;
-      return cell_key(cells[a.cell]) > cell_key(cells[b.cell]);
+      return cell_key(a.cell) > cell_key(b.cell);
     };
     std::priority_queue<Entry, std::vector<Entry>, decltype(later)> queue(
         later);
-    for (size_t i = 0; i < n; ++i)
-      if (ball[i].r2 < 0) {
-        eout[i] = 2; // above any weight
-        queue.push(Entry{2, uint32_t(i)});
+    auto push = [&](float prio, Ch c) { queue.push(Entry{prio, c}); };
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
+      if (dt_.is_infinite(c)) {
+        eout[c->info().w.local] = 2; // above any weight
+        push(2, c);
       }
     // Samples on the hull: the outside is their first pole.
     for (size_t v = 0; v < poles_.size(); ++v)
-      if (poles_[v].hull && poles_[v].second != kNone) {
-        const uint32_t q = poles_[v].second;
-        const float w =
-            float(-cos_at(vh_[v]->point(), poles_[v].dir, ball[q].o));
-        if (w > ein[q]) {
-          ein[q] = w;
-          queue.push(Entry{priority(q), q});
+      if (poles_[v].hull && poles_[v].second != Ch()) {
+        const Ch q = poles_[v].second;
+        const uint32_t j = q->info().w.local;
+        const float w = -cos_at(vh_[v]->point(), poles_[v].dir, ball[j].o);
+        if (w > ein[j]) {
+          ein[j] = w;
+          push(priority(j), q);
         }
       }
 
@@ -132,23 +132,25 @@ private:
     while (!queue.empty()) {
       const Entry e = queue.top();
       queue.pop();
-      const uint32_t i = e.cell;
-      if (lab[i] != kUnlabelled || e.prio != priority(i))
+      Ch c = e.cell;
+      CellLabel &cw = c->info().w;
+      const uint32_t i = cw.local;
+      if (cw.label != kUnlabelled || e.prio != priority(i))
         continue; // labelled already, or its evidence has grown since
       if ((++done & 0xFFFF) == 0)
         progress.tick(1, 3);
-      lab[i] = ein[i] > eout[i] ? kInside : kOutside;
-      const bool in = lab[i] == kInside;
-      Ch c = cells[i];
+      cw.label = ein[i] > eout[i] ? kInside : kOutside;
+      const bool in = cw.label == kInside;
       for (int f = 0; f < 4; ++f) {
-        const uint32_t j = c->neighbor(f)->info().w.local;
-        if (lab[j] != kUnlabelled)
+        Ch nb = c->neighbor(f);
+        if (nb->info().w.label != kUnlabelled)
           continue;
-        const float w = float(-crossing(c, f, ball));
+        const uint32_t j = nb->info().w.local;
+        const float w = -crossing(c, f, ball);
         float &same = in ? ein[j] : eout[j];
         if (w > same) {
           same = w;
-          queue.push(Entry{priority(j), j});
+          push(priority(j), nb);
         }
       }
       if (ball[i].r2 < 0)
@@ -156,52 +158,52 @@ private:
       for (int k = 0; k < 4; ++k) {
         const uint32_t v = c->vertex(k)->info().idx;
         const Poles &p = poles_[v];
-        const uint32_t q = p.first == i    ? p.second
-                           : p.second == i ? p.first
-                                           : kNone;
-        if (q == kNone || lab[q] != kUnlabelled)
+        const Ch q = p.first == c ? p.second : p.second == c ? p.first : Ch();
+        if (q == Ch() || q->info().w.label != kUnlabelled)
           continue;
         const Point &s = vh_[v]->point();
-        const double a[3] = {ball[i].o[0] - s.x(), ball[i].o[1] - s.y(),
-                             ball[i].o[2] - s.z()};
-        const float w = float(-cos_at(s, a, ball[q].o));
-        float &other = in ? eout[q] : ein[q];
+        const float a[3] = {float(ball[i].o[0] - s.x()),
+                            float(ball[i].o[1] - s.y()),
+                            float(ball[i].o[2] - s.z())};
+        const uint32_t j = q->info().w.local;
+        const float w = -cos_at(s, a, ball[j].o);
+        float &other = in ? eout[j] : ein[j];
         if (w > other) {
           other = w;
-          queue.push(Entry{priority(q), q});
+          push(priority(j), q);
         }
       }
     }
-    for (size_t i = 0; i < n; ++i) {
-      CellLabel &w = cells[i]->info().w;
-      w.label = lab[i] == kInside ? kInside : kOutside;
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
+      CellLabel &w = c->info().w;
+      if (w.label != kInside)
+        w.label = kOutside;
       w.local = 0;
     }
     poles_ = std::vector<Poles>();
   }
 
   struct Ball {
-    double o[3];
-    double r2; // squared radius; negative for an infinite cell
+    float o[3];
+    float r2; // squared radius; negative for an infinite cell
   };
-  static constexpr uint32_t kNone = UINT32_MAX;
   // A sample's poles: the cells of its farthest circumcentre (first) and of
   // the farthest on the other side (second); on the hull, the outside is
   // the first (dir, the sum of the outward normals of its hull facets).
   struct Poles {
-    uint32_t first = kNone, second = kNone;
+    Ch first, second;
+    float dir[3] = {0, 0, 0}; // from the sample toward the first pole
+    float far2 = -1;          // scratch: the farthest distance so far
     bool hull = false;
-    double dir[3] = {0, 0, 0}; // from the sample toward the first pole
-    double far2 = -1;          // scratch: the farthest distance so far
   };
 
   // The poles of every sample (section 4.2), from the circumcentres, in two
   // passes over the cells.
-  void find_poles(const std::vector<Ch> &cells, const std::vector<Ball> &ball) {
+  void find_poles(const std::vector<Ball> &ball) {
     poles_.assign(vh_.size(), Poles());
-    for (size_t i = 0; i < cells.size(); ++i) {
-      Ch c = cells[i];
-      if (ball[i].r2 < 0) {
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
+      const Ball &b = ball[c->info().w.local];
+      if (b.r2 < 0) {
         // A hull facet: its outward normal goes to its three samples.
         const int k = c->index(dt_.infinite_vertex());
         double nrm[3];
@@ -211,46 +213,44 @@ private:
           Poles &p = poles_[c->vertex((k + j) % 4)->info().idx];
           p.hull = true;
           for (int a = 0; a < 3; ++a)
-            p.dir[a] += nrm[a];
+            p.dir[a] += float(nrm[a]);
         }
         continue;
       }
       for (int j = 0; j < 4; ++j) {
         Poles &p = poles_[c->vertex(j)->info().idx];
-        const double d2 = dist2(c->vertex(j)->point(), ball[i].o);
+        const float d2 = dist2(c->vertex(j)->point(), b.o);
         if (d2 > p.far2) {
           p.far2 = d2;
-          p.first = uint32_t(i);
+          p.first = c;
         }
       }
     }
     for (size_t v = 0; v < poles_.size(); ++v) {
       Poles &p = poles_[v];
       if (p.hull) {
-        p.first = kNone;
-      } else if (p.first != kNone) {
+        p.first = Ch();
+      } else if (p.first != Ch()) {
         const Point &s = vh_[v]->point();
-        const double *o = ball[p.first].o;
-        p.dir[0] = o[0] - s.x(), p.dir[1] = o[1] - s.y(),
-        p.dir[2] = o[2] - s.z();
+        const float *o = ball[p.first->info().w.local].o;
+        p.dir[0] = float(o[0] - s.x()), p.dir[1] = float(o[1] - s.y()),
+        p.dir[2] = float(o[2] - s.z());
       }
       p.far2 = -1;
     }
-    for (size_t i = 0; i < cells.size(); ++i) {
-      if (ball[i].r2 < 0)
-        continue;
-      Ch c = cells[i];
+    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
+      const float *o = ball[c->info().w.local].o;
       for (int j = 0; j < 4; ++j) {
         Poles &p = poles_[c->vertex(j)->info().idx];
         const Point &s = c->vertex(j)->point();
-        const double *o = ball[i].o;
-        const double a[3] = {o[0] - s.x(), o[1] - s.y(), o[2] - s.z()};
+        const float a[3] = {float(o[0] - s.x()), float(o[1] - s.y()),
+                            float(o[2] - s.z())};
         if (a[0] * p.dir[0] + a[1] * p.dir[1] + a[2] * p.dir[2] >= 0)
           continue;
-        const double d2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        const float d2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
         if (d2 > p.far2) {
           p.far2 = d2;
-          p.second = uint32_t(i);
+          p.second = c;
         }
       }
     }
@@ -284,7 +284,7 @@ private:
   // neighbour across facet f cross: 1 where they only touch, -1 where one
   // holds the other. For an infinite neighbour, its ball is the outer
   // half-space of the hull facet.
-  double crossing(Ch c, int f, const std::vector<Ball> &ball) const {
+  float crossing(Ch c, int f, const std::vector<Ball> &ball) const {
     Ch nb = c->neighbor(f);
     const Ball &p = ball[c->info().w.local], &q = ball[nb->info().w.local];
     if (p.r2 < 0 && q.r2 < 0)
@@ -301,26 +301,28 @@ private:
       const Point &a = fin->vertex((fi + 1) % 4)->point();
       const double h = nrm[0] * (b.o[0] - a.x()) + nrm[1] * (b.o[1] - a.y()) +
                        nrm[2] * (b.o[2] - a.z());
-      return std::max(-1.0, std::min(1.0, -h / std::sqrt(b.r2)));
+      return float(std::max(-1.0, std::min(1.0, -h / std::sqrt(double(b.r2)))));
     }
-    double d2 = 0;
+    float d2 = 0;
     for (int k = 0; k < 3; ++k)
       d2 += (p.o[k] - q.o[k]) * (p.o[k] - q.o[k]);
-    const double den = 2 * std::sqrt(p.r2 * q.r2);
+    const float den = 2 * std::sqrt(p.r2 * q.r2);
     if (!(den > 0))
       return 0;
-    return std::max(-1.0, std::min(1.0, (d2 - p.r2 - q.r2) / den));
+    return std::max(-1.0f, std::min(1.0f, (d2 - p.r2 - q.r2) / den));
   }
 
-  static double dist2(const Point &s, const double o[3]) {
-    return (o[0] - s.x()) * (o[0] - s.x()) + (o[1] - s.y()) * (o[1] - s.y()) +
-           (o[2] - s.z()) * (o[2] - s.z());
+  static float dist2(const Point &s, const float o[3]) {
+    const float a[3] = {float(o[0] - s.x()), float(o[1] - s.y()),
+                        float(o[2] - s.z())};
+    return a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
   }
   // The cosine of the angle at sample s between direction a and point o.
-  static double cos_at(const Point &s, const double a[3], const double o[3]) {
-    const double b[3] = {o[0] - s.x(), o[1] - s.y(), o[2] - s.z()};
-    const double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    const double bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+  static float cos_at(const Point &s, const float a[3], const float o[3]) {
+    const float b[3] = {float(o[0] - s.x()), float(o[1] - s.y()),
+                        float(o[2] - s.z())};
+    const float aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    const float bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
     if (!(aa > 0 && bb > 0))
       return 0;
     return (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / std::sqrt(aa * bb);

@@ -130,13 +130,16 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   Surface a;
   sc_diag_t da = diag;
   auto label = [&] {
-    // The triangulation went after the candidates, for it is most of the
-    // memory: build it again over the same points, numbered as the
-    // surface's vertices are.
-    double box[6];
-    bounding_box(lxyz, m, box);
-    std::unique_ptr<Triangulator> dt = make_triangulator(params_.threads, box);
-    dt->insert(lxyz, 0, m, progress);
+    // The triangulation that filter() kept; or, where it went after the
+    // candidates (--patches), built again over the same points, numbered
+    // as the surface's vertices are.
+    std::unique_ptr<Triangulator> dt = std::move(kept_);
+    if (!dt) {
+      double box[6];
+      bounding_box(lxyz, m, box);
+      dt = make_triangulator(params_.threads, box);
+      dt->insert(lxyz, 0, m, progress);
+    }
     std::vector<uint32_t> labelled;
     if (!dt->close(labelled, progress, da))
       return false;
@@ -181,6 +184,7 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   } else if (labels_only) {
     patch(); // no cell came out inside
   }
+  kept_.reset();
   // Pockets: closing may leave small closed components inside the main one
   // (the inside of a bubble, a cap that closed on itself). Those under a
   // hundredth of the surface go; their samples may be attached later.
@@ -557,7 +561,13 @@ sc_mesh_t *Recon::finish() {
     // the rest, exactly.
     if (dt_raw_ && !shifted_.empty())
       dt_->translate(shift_);
+    // Watertight mode labels the cells of this triangulation (section
+    // 11.4) unless the patches come first.
+    dt_->keep = params_.mode == SC_MODE_WATERTIGHT &&
+                (params_.watertight_labels || !params_.watertight_patches);
     dt_->filter(work, n_, params_, progress, f, diag, seconds_);
+    if (dt_->keep)
+      kept_ = std::move(dt_);
     dt_.reset();
   }
   const bool watertight = params_.mode == SC_MODE_WATERTIGHT;
