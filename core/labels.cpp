@@ -108,8 +108,10 @@ private:
         return a.prio < b.prio;
       return cell_key(a.cell) > cell_key(b.cell);
     };
+    std::vector<Entry> entries;
+    entries.reserve(n / 2); // the most measured at once: about a third
     std::priority_queue<Entry, std::vector<Entry>, decltype(later)> queue(
-        later);
+        later, std::move(entries));
     auto push = [&](float prio, Ch c) { queue.push(Entry{prio, c}); };
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
       if (dt_.is_infinite(c)) {
@@ -463,7 +465,8 @@ private:
     }
     std::vector<uint32_t> &size = size_;
     size.assign(k, 0);
-    std::vector<uint8_t> fixed(k, 0);
+    std::vector<uint8_t> &fixed = fixed_;
+    fixed.assign(k, 0);
     int pieces[3] = {0, 0, 0};
     for (size_t i = 0; i < k; ++i) {
       uint32_t r = find(uint32_t(i));
@@ -519,6 +522,7 @@ private:
   std::vector<Ch> star_; // scratch of repair_vertex()
   std::vector<std::pair<std::array<uint32_t, 4>, Ch>> keyed_; // likewise
   std::vector<uint32_t> parent_, size_;
+  std::vector<uint8_t> fixed_;
   std::vector<Poles> poles_; // by vertex number, while weigh() runs
 };
 
