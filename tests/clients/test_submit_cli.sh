@@ -42,7 +42,8 @@ for in in knot1_points kitten_points noisy; do
   file=$data/$in.ply
   modes="--mode_cocone --mode_shortcrust_--r_0.14 --mode_auto --mode_watertight
          --mode_boundary_--max-hole_0_--rho_1.2_--alpha_25
-         --mode_watertight_--labels_--paper-pruning --mode_cocone_--denoise"
+         --mode_watertight_--labels_--paper-pruning --mode_watertight_--patches
+         --mode_cocone_--denoise"
   if [ "$in" = noisy ]; then
     file=$data_noisy
     # --smoothed-vertices: the daemon sends the positions it smoothed, and
