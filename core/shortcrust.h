@@ -199,13 +199,14 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    them, and only tile tile_index is computed; the result is not a mesh
  *    but what sc_reconstruct_merge() needs of that tile: see there.
  *    tile_count 0, the default, is the whole job.
- *  - watertight_labels, watertight_patches: by default (and always with
- *    watertight_labels 1) watertight mode labels the Delaunay cells inside
- *    or outside by their empty balls, and the output is the boundary of the
- *    inside cells; least-area patches close the holes of the extracted
- *    surface only when no cell comes out inside. watertight_patches 1
- *    (with watertight_labels 0) patches first, keeping the extracted
- *    surface, and labels only where the patches cannot close it.
+ *  - watertight_labels, watertight_patches: by default watertight mode
+ *    closes the surface two ways, by least-area patches over the holes of
+ *    the extracted surface and by labelling the Delaunay cells inside or
+ *    outside by their empty balls (the boundary of the inside cells), and
+ *    keeps the better closure (docs/modes.md). watertight_labels 1 takes
+ *    the labelling alone (the patches only when no cell comes out inside);
+ *    watertight_patches 1 (with watertight_labels 0) patches first and
+ *    labels only where the patches leave the surface open.
  */
 #define SC_RANGE_CLOSED 0      /* lo <= v <= hi */
 #define SC_RANGE_LO_OPEN 1     /* lo < v */
@@ -258,8 +259,9 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "boundary detection: largest angle between neighbouring poles")            \
   X(watertight_labels, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION,  \
     0, "labels", NULL,                                                         \
-    "watertight mode: close the surface by labelling Delaunay cells inside "   \
-    "or outside (the default; overrides --patches)")                           \
+    "watertight mode: close the surface by labelling the Delaunay cells "      \
+    "inside or outside alone (default: patches and labelling, the better "     \
+    "kept; overrides --patches)")                                              \
   X(watertight_patches, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION, \
     0, "patches", NULL,                                                        \
     "watertight mode: close the holes of the extracted surface with "          \
