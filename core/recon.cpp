@@ -156,11 +156,9 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     return true;
   };
   auto take_labels = [&] {
-    const uint64_t relabelled = da.cells_relabelled;
     surf = std::move(a);
     diag = da;
     diag.path = SC_PATH_WATERTIGHT;
-    diag.cells_relabelled = relabelled;
   };
 
   bool open = false;
