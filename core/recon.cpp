@@ -101,7 +101,8 @@ struct Closure {
 } // namespace
 
 // Watertight mode, after extraction (docs/algorithm.md sections 11.2 to
-// 11.5): closes surf, in two ways, and keeps the better (see Closure):
+// 11.5): closes surf, in two ways where the first leaves doubt, and keeps
+// the better (see Closure):
 //  - the least-area patches over the holes of the extracted surface, after
 //    cutting the handles that closed round a hole of a scan; they keep the
 //    extracted surface as it is;
@@ -176,7 +177,22 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   const bool patches_first = !labels_only && params_.watertight_patches != 0;
   if (!labels_only)
     patch();
-  if ((labels_only || !patches_first || !Closure(diag).ok) && label()) {
+  // The labelling is tried where the patches' closure shows a defect: open,
+  // in pieces, samples left out, or a handle that had to be cut. Where the
+  // patches give one closed piece (pockets aside) with no handle cut and
+  // at least 99.9% of the samples on it before any is attached (the
+  // project's own target), it is not (section 11.5).
+  auto doubtful = [&] {
+    const Closure c(diag);
+    // Pockets under a hundredth of the surface go below: they do not count.
+    uint64_t pieces = 0;
+    for (const Surface::Part &p : surf.parts)
+      pieces += uint64_t(100 * p.faces) >= surf.tris.size() / 3;
+    return !c.ok || c.loops > 0 || pieces != 1 || diag.handles_cut > 0 ||
+           1000 * c.unused > m;
+  };
+  if ((labels_only || (patches_first ? !Closure(diag).ok : doubtful())) &&
+      label()) {
     if (labels_only || !Closure(diag).better_than(Closure(da)))
       take_labels();
   } else if (labels_only) {
@@ -559,10 +575,12 @@ sc_mesh_t *Recon::finish() {
     // the rest, exactly.
     if (dt_raw_ && !shifted_.empty())
       dt_->translate(shift_);
-    // Watertight mode labels the cells of this triangulation (section
-    // 11.4) unless the patches come first.
-    dt_->keep = params_.mode == SC_MODE_WATERTIGHT &&
-                (params_.watertight_labels || !params_.watertight_patches);
+    // Watertight mode's labelling alone (--labels) labels the cells of
+    // this triangulation (section 11.4). Otherwise it goes: the labelling
+    // runs only where the patches leave doubt (close_surface()), and then
+    // on the same triangulation built again, so that the peak memory stays
+    // that of the patches where they suffice.
+    dt_->keep = params_.mode == SC_MODE_WATERTIGHT && params_.watertight_labels;
     dt_->filter(work, n_, params_, progress, f, diag, seconds_);
     if (dt_->keep)
       kept_ = std::move(dt_);

@@ -200,10 +200,12 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    but what sc_reconstruct_merge() needs of that tile: see there.
  *    tile_count 0, the default, is the whole job.
  *  - watertight_labels, watertight_patches: by default watertight mode
- *    closes the surface two ways, by least-area patches over the holes of
- *    the extracted surface and by labelling the Delaunay cells inside or
- *    outside by their empty balls (the boundary of the inside cells), and
- *    keeps the better closure (docs/modes.md). watertight_labels 1 takes
+ *    closes the surface by least-area patches over the holes of the
+ *    extracted surface and, where those leave doubt (not one closed piece,
+ *    a handle cut, more than 0.1% of the samples left out), also by
+ *    labelling the Delaunay cells inside or outside by their empty balls
+ *    (the boundary of the inside cells), and keeps the better closure
+ *    (docs/modes.md). watertight_labels 1 takes
  *    the labelling alone (the patches only when no cell comes out inside);
  *    watertight_patches 1 (with watertight_labels 0) patches first and
  *    labels only where the patches leave the surface open.

@@ -146,6 +146,35 @@ int main(int argc, char **argv) {
     EXPECT(m3 && m3->smoothed &&
            memcmp(m3->smoothed, m->smoothed, 3 * n * sizeof *m->smoothed) == 0);
     sc_mesh_free(m3);
+
+    if (mode == SC_MODE_WATERTIGHT) {
+      /* The labelling runs only where the patches leave doubt
+       * (docs/modes.md, watertight mode, step 2): where the patches alone
+       * give one closed piece, no handle cut and at most one sample in a
+       * thousand off it before attaching, the default is their mesh. */
+      q = p;
+      q.smoothed_vertices = 0;
+      q.watertight_patches = 1;
+      sc_mesh_t *mp = NULL;
+      ASSERT_EQ(sc_reconstruct(xyz, n, &q, &mp, msg, sizeof msg), 0);
+      const sc_diag_t *d = &mp->diag;
+      const int settled = d->closed && d->components == 1 &&
+                          d->boundary_loops == 0 && d->nonmanifold_edges == 0 &&
+                          d->nonmanifold_vertices == 0 && d->handles_cut == 0 &&
+                          1000 * (d->samples_unused + d->samples_attached) <= n;
+      printf("patches alone: %s (%llu samples attached, %llu unused); "
+             "default path %s\n",
+             settled ? "settled" : "in doubt",
+             (unsigned long long)d->samples_attached,
+             (unsigned long long)d->samples_unused, sc_path_name(m->diag.path));
+      if (settled) {
+        EXPECT_EQ(m->diag.path, d->path);
+        EXPECT(mp->triangle_count == m->triangle_count &&
+               memcmp(mp->triangles, m->triangles,
+                      3 * m->triangle_count * sizeof *m->triangles) == 0);
+      }
+      sc_mesh_free(mp);
+    }
   } else {
     /* Nothing to smooth: the mesh without denoising, no positions. */
     EXPECT_NULL(m->smoothed);
