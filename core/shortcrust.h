@@ -491,9 +491,11 @@ const char *sc_diag_element_name(const sc_diag_info_t *row, size_t i);
  * sample spacings, and the sample resolves its surface (sc_diag_t.curvature
  * at most 0.15 + noise / 2): below the floor the Delaunay filtering needs
  * no help, and on a coarse sample what the estimate takes for noise is the
- * shape, which smoothing would flatten. A denoise_scale given by the
- * caller smooths whatever the estimate. (docs/algorithm.md section 16.) */
-#define SC_NOISE_FLOOR 0.10
+ * shape, which smoothing would flatten. The estimate reads about 0.09 at a
+ * noise of 0.1 spacings, where the filtering alone starts to fail. A
+ * denoise_scale given by the caller smooths whatever the estimate.
+ * (docs/algorithm.md section 16.) */
+#define SC_NOISE_FLOOR 0.08
 
 /* Values of sc_diag_t.path: X(NAME, value, name).
  *  - SHORTCRUST: the paper's criteria.

@@ -93,7 +93,7 @@ expect 0 "" "$sc" reconstruct "$knot" -o "$tmp/t.ply" --threads 2 --quiet
 # Noise: every summary gives the estimate; a clean sample is not smoothed
 # even with --denoise, and says why.
 expect 0 "Noise: 0.0[0-9] spacings" "$sc" reconstruct "$knot" -o "$tmp/d.ply"
-expect 0 "below 0.10, not smoothed" "$sc" reconstruct "$knot" -o "$tmp/d.ply" --denoise
+expect 0 "below 0.08, not smoothed" "$sc" reconstruct "$knot" -o "$tmp/d.ply" --denoise
 grep -q '"denoised": false' "$tmp/r.json" || fail "report lacks \"denoised\": false"
 grep -q '"noise": ' "$tmp/r.json" || fail "report lacks the noise estimate"
 # A torus with noise of half a spacing: broken without denoising, its
