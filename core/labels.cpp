@@ -69,192 +69,276 @@ private:
   //    where it has both, so that conflicting cells wait. Ties go by the
   //    cells' vertex numbers, not their places in memory.
   // A cell no weight reaches stays outside.
+  //
+  // Weighing reads arrays indexed by the cells' numbers (number_cells()),
+  // not the cells; where numbers would decide (ties), the cells' keys do
+  // (cell_key()), so that nothing depends on where the cells lie in
+  // memory.
   void weigh(Progress &progress) {
-    // Cells are numbered in w.local for the arrays below, in memory order;
-    // nothing that decides a label depends on that order.
-    size_t n = 0;
-    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
-      c->info().w.local = uint32_t(n++);
-    // Circumcentres and squared radii, in single precision: they weigh
-    // evidence, and the cosines lose nothing that matters (the error is
-    // relative to the radii). r2 < 0 marks an infinite cell.
-    std::vector<Ball> ball(n);
+    const size_t n = number_cells();
+    progress.tick(0, 4);
+    // Per cell: its neighbours' numbers and its ball (for an infinite
+    // cell, r2 < 0 and o[0] the crossing with its finite neighbour, see
+    // crossing()).
+    node_.resize(n);
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
-      Ball &b = ball[c->info().w.local];
-      if (dt_.is_infinite(c)) {
-        b.r2 = -1;
-        continue;
-      }
+      Node &d = node_[c->info().w.local];
+      for (int f = 0; f < 4; ++f)
+        d.nbr[f] = c->neighbor(f)->info().w.local;
+      if (dt_.is_infinite(c))
+        continue; // after the finite ones, below
       const Point o =
           CGAL::circumcenter(c->vertex(0)->point(), c->vertex(1)->point(),
                              c->vertex(2)->point(), c->vertex(3)->point());
-      b = Ball{{float(o.x()), float(o.y()), float(o.z())},
-               float(CGAL::squared_distance(o, c->vertex(0)->point()))};
+      d.o[0] = float(o.x()), d.o[1] = float(o.y()), d.o[2] = float(o.z());
+      d.r2 = float(CGAL::squared_distance(o, c->vertex(0)->point()));
     }
-    progress.tick(0, 3);
-    find_poles(ball);
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
+      if (dt_.is_infinite(c)) {
+        Node &d = node_[c->info().w.local];
+        d.o[0] = hull_crossing(c, c->index(dt_.infinite_vertex()));
+        d.r2 = -1;
+      }
+    progress.tick(1, 4);
+    find_poles();
+    progress.tick(2, 4);
 
-    std::vector<float> ein(n, 0), eout(n, 0);
-    auto priority = [&](size_t i) {
-      const float a = ein[i], b = eout[i];
+    auto priority = [](const Node &d) {
+      const float a = d.ein, b = d.eout;
       return a > 0 && b > 0 ? std::fabs(a - b) - 1 : std::max(a, b);
     };
+    // The clearest evidence first; of equal evidence, the smaller key.
     struct Entry {
       float prio;
-      Ch cell;
+      uint32_t cell;
     };
     auto later = [&](const Entry &a, const Entry &b) {
       if (a.prio != b.prio)
         return a.prio < b.prio;
-      return cell_key(a.cell) > cell_key(b.cell);
+      return a.cell != b.cell && key_less(b.cell, a.cell);
     };
     std::vector<Entry> entries;
     entries.reserve(n / 2); // the most measured at once: about a third
     std::priority_queue<Entry, std::vector<Entry>, decltype(later)> queue(
         later, std::move(entries));
-    auto push = [&](float prio, Ch c) { queue.push(Entry{prio, c}); };
-    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
-      if (dt_.is_infinite(c)) {
-        eout[c->info().w.local] = 2; // above any weight
-        push(2, c);
+    for (size_t i = 0; i < n; ++i)
+      if (node_[i].r2 < 0) {
+        node_[i].eout = 2; // above any weight
+        queue.push(Entry{2, uint32_t(i)});
       }
     // Samples on the hull: the outside is their first pole.
-    for (size_t v = 0; v < poles_.size(); ++v)
-      if (poles_[v].hull && poles_[v].second != Ch()) {
-        const Ch q = poles_[v].second;
-        const uint32_t j = q->info().w.local;
-        const float w = -cos_at(vh_[v]->point(), poles_[v].dir, ball[j].o);
-        if (w > ein[j]) {
-          ein[j] = w;
-          push(priority(j), q);
-        }
+    for (const Link &h : hull_poles_) {
+      Node &d = node_[h.cell];
+      if (h.w > d.ein) {
+        d.ein = h.w;
+        queue.push(Entry{priority(d), h.cell});
       }
+    }
 
     size_t done = 0;
     while (!queue.empty()) {
       const Entry e = queue.top();
       queue.pop();
-      Ch c = e.cell;
-      CellLabel &cw = c->info().w;
-      const uint32_t i = cw.local;
-      if (cw.label != kUnlabelled || e.prio != priority(i))
+      const uint32_t i = e.cell;
+      Node &d = node_[i];
+      if (d.label != kUnlabelled || e.prio != priority(d))
         continue; // labelled already, or its evidence has grown since
       if ((++done & 0xFFFF) == 0)
-        progress.tick(1, 3);
-      cw.label = ein[i] > eout[i] ? kInside : kOutside;
-      const bool in = cw.label == kInside;
+        progress.tick(3, 4);
+      d.label = d.ein > d.eout ? kInside : kOutside;
+      const bool in = d.label == kInside;
       for (int f = 0; f < 4; ++f) {
-        Ch nb = c->neighbor(f);
-        if (nb->info().w.label != kUnlabelled)
+        const uint32_t j = d.nbr[f];
+        Node &b = node_[j];
+        if (b.label != kUnlabelled)
           continue;
-        const uint32_t j = nb->info().w.local;
-        const float w = -crossing(c, f, ball);
-        float &same = in ? ein[j] : eout[j];
+        const float w = -crossing(d, b);
+        float &same = in ? b.ein : b.eout;
         if (w > same) {
           same = w;
-          push(priority(j), nb);
+          queue.push(Entry{priority(b), j});
         }
       }
-      if (ball[i].r2 < 0)
-        continue;
-      for (int k = 0; k < 4; ++k) {
-        const uint32_t v = c->vertex(k)->info().idx;
-        const Poles &p = poles_[v];
-        const Ch q = p.first == c ? p.second : p.second == c ? p.first : Ch();
-        if (q == Ch() || q->info().w.label != kUnlabelled)
+      // The samples whose pole this cell is: their other poles.
+      for (uint32_t k = d.link_at; k < d.link_at + d.links; ++k) {
+        const Link &l = links_[k];
+        Node &b = node_[l.cell];
+        if (b.label != kUnlabelled)
           continue;
-        const Point &s = vh_[v]->point();
-        const float a[3] = {float(ball[i].o[0] - s.x()),
-                            float(ball[i].o[1] - s.y()),
-                            float(ball[i].o[2] - s.z())};
-        const uint32_t j = q->info().w.local;
-        const float w = -cos_at(s, a, ball[j].o);
-        float &other = in ? eout[j] : ein[j];
-        if (w > other) {
-          other = w;
-          push(priority(j), q);
+        float &other = in ? b.eout : b.ein;
+        if (l.w > other) {
+          other = l.w;
+          queue.push(Entry{priority(b), l.cell});
         }
       }
     }
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
       CellLabel &w = c->info().w;
-      if (w.label != kInside)
-        w.label = kOutside;
+      w.label = node_[w.local].label == kInside ? kInside : kOutside;
       w.local = 0;
     }
-    poles_ = std::vector<Poles>();
+    node_ = {};
+    links_ = {};
+    hull_poles_ = {};
+    cells_ = {};
+    kmin_ = {};
   }
 
-  struct Ball {
-    float o[3];
-    float r2; // squared radius; negative for an infinite cell
+  // Numbers every cell, in w.local, in memory order, and notes each one's
+  // handle and smallest vertex number; returns how many. (Ordering the
+  // cells around the vertices along the insertion's space-filling curve
+  // instead was measured: no faster.)
+  size_t number_cells() {
+    const size_t n = dt_.tds().number_of_cells();
+    cells_.resize(n);
+    kmin_.resize(n);
+    uint32_t i = 0;
+    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c, ++i) {
+      c->info().w.local = i;
+      cells_[i] = c;
+      uint32_t k = UINT32_MAX;
+      for (int j = 0; j < 4; ++j)
+        if (!dt_.is_infinite(c->vertex(j)))
+          k = std::min(k, c->vertex(j)->info().idx);
+      kmin_[i] = k;
+    }
+    return n;
+  }
+  // Whether cell i's key is smaller than cell j's.
+  bool key_less(uint32_t i, uint32_t j) const {
+    return kmin_[i] != kmin_[j] ? kmin_[i] < kmin_[j]
+                                : cell_key(cells_[i]) < cell_key(cells_[j]);
+  }
+
+  // What weighing reads of a cell, together.
+  struct Node {
+    uint32_t nbr[4];  // the neighbours' numbers
+    float o[3];       // the circumcentre
+    float r2;         // squared radius; negative for an infinite cell
+    float ein = 0, eout = 0; // the evidence for inside, and for outside
+    uint32_t link_at = 0;    // its first pole link (links_)
+    uint8_t links = 0;       // and how many (at most one a vertex)
+    uint8_t label = kUnlabelled;
   };
   // A sample's poles: the cells of its farthest circumcentre (first) and of
   // the farthest on the other side (second); on the hull, the outside is
   // the first (dir, the sum of the outward normals of its hull facets).
   struct Poles {
-    Ch first, second;
+    uint32_t first = UINT32_MAX, second = UINT32_MAX;
     float dir[3] = {0, 0, 0}; // from the sample toward the first pole
     float far2 = -1;          // scratch: the farthest distance so far
     bool hull = false;
   };
+  // Evidence from a pole to the sample's other pole (cell), of weight w.
+  struct Link {
+    uint32_t cell;
+    float w;
+  };
 
   // The poles of every sample (section 4.2), from the circumcentres, in two
-  // passes over the cells.
-  void find_poles(const std::vector<Ball> &ball) {
-    poles_.assign(vh_.size(), Poles());
-    for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
-      const Ball &b = ball[c->info().w.local];
-      if (b.r2 < 0) {
-        // A hull facet: its outward normal goes to its three samples.
-        const int k = c->index(dt_.infinite_vertex());
-        double nrm[3];
-        if (!outward_normal(c, k, nrm))
-          continue;
-        for (int j = 1; j < 4; ++j) {
-          Poles &p = poles_[c->vertex((k + j) % 4)->info().idx];
-          p.hull = true;
-          for (int a = 0; a < 3; ++a)
-            p.dir[a] += float(nrm[a]);
-        }
+  // passes over the cells; then the evidence each pole gives the other
+  // (links_, by cell: Node::link_at and links), and the hull samples'
+  // (hull_poles_).
+  void find_poles() {
+    const size_t m = vh_.size();
+    std::vector<Poles> poles(m);
+    // Hull facets, in the order of their numbers (the sums below are of
+    // floats): each one's outward normal goes to its three samples.
+    std::vector<uint32_t> hull;
+    for (uint32_t i = 0; i < node_.size(); ++i)
+      if (node_[i].r2 < 0)
+        hull.push_back(i);
+    std::sort(hull.begin(), hull.end(),
+              [&](uint32_t a, uint32_t b) { return key_less(a, b); });
+    for (const uint32_t h : hull) {
+      const Ch c = cells_[h];
+      const int k = c->index(dt_.infinite_vertex());
+      double nrm[3];
+      if (!outward_normal(c, k, nrm))
         continue;
+      for (int j = 1; j < 4; ++j) {
+        Poles &p = poles[c->vertex((k + j) % 4)->info().idx];
+        p.hull = true;
+        for (int a = 0; a < 3; ++a)
+          p.dir[a] += float(nrm[a]);
       }
+    }
+    for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
+      const uint32_t i = c->info().w.local;
+      const Node &b = node_[i];
       for (int j = 0; j < 4; ++j) {
-        Poles &p = poles_[c->vertex(j)->info().idx];
+        Poles &p = poles[c->vertex(j)->info().idx];
         const float d2 = dist2(c->vertex(j)->point(), b.o);
-        if (d2 > p.far2) {
+        // Of equal distances, the smaller key.
+        if (d2 > p.far2 || (d2 == p.far2 && key_less(i, p.first))) {
           p.far2 = d2;
-          p.first = c;
+          p.first = i;
         }
       }
     }
-    for (size_t v = 0; v < poles_.size(); ++v) {
-      Poles &p = poles_[v];
+    for (size_t v = 0; v < m; ++v) {
+      Poles &p = poles[v];
       if (p.hull) {
-        p.first = Ch();
-      } else if (p.first != Ch()) {
+        p.first = UINT32_MAX;
+      } else if (p.first != UINT32_MAX) {
         const Point &s = vh_[v]->point();
-        const float *o = ball[p.first->info().w.local].o;
+        const float *o = node_[p.first].o;
         p.dir[0] = float(o[0] - s.x()), p.dir[1] = float(o[1] - s.y()),
         p.dir[2] = float(o[2] - s.z());
       }
       p.far2 = -1;
     }
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
-      const float *o = ball[c->info().w.local].o;
+      const uint32_t i = c->info().w.local;
+      const float *o = node_[i].o;
       for (int j = 0; j < 4; ++j) {
-        Poles &p = poles_[c->vertex(j)->info().idx];
+        Poles &p = poles[c->vertex(j)->info().idx];
         const Point &s = c->vertex(j)->point();
         const float a[3] = {float(o[0] - s.x()), float(o[1] - s.y()),
                             float(o[2] - s.z())};
         if (a[0] * p.dir[0] + a[1] * p.dir[1] + a[2] * p.dir[2] >= 0)
           continue;
         const float d2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-        if (d2 > p.far2) {
+        if (d2 > p.far2 || (d2 == p.far2 && key_less(i, p.second))) {
           p.far2 = d2;
-          p.second = c;
+          p.second = i;
         }
       }
+    }
+    // Each labelled pole tells the sample's other pole to take the other
+    // label, with the weight -cos of the angle between them at the sample.
+    auto weight = [&](const Point &s, uint32_t from, uint32_t to) {
+      const float a[3] = {float(node_[from].o[0] - s.x()),
+                          float(node_[from].o[1] - s.y()),
+                          float(node_[from].o[2] - s.z())};
+      return -cos_at(s, a, node_[to].o);
+    };
+    for (size_t v = 0; v < m; ++v) {
+      const Poles &p = poles[v];
+      if (p.first != UINT32_MAX && p.second != UINT32_MAX) {
+        ++node_[p.first].links;
+        ++node_[p.second].links;
+      }
+    }
+    uint32_t total = 0;
+    for (Node &d : node_) {
+      d.link_at = total;
+      total += d.links;
+      d.links = 0; // counted again as they are filled in
+    }
+    links_.resize(total);
+    hull_poles_.clear();
+    for (size_t v = 0; v < m; ++v) {
+      const Poles &p = poles[v];
+      const Point &s = vh_[v]->point();
+      if (p.hull && p.second != UINT32_MAX)
+        hull_poles_.push_back(
+            Link{p.second, -cos_at(s, p.dir, node_[p.second].o)});
+      if (p.first == UINT32_MAX || p.second == UINT32_MAX)
+        continue;
+      Node &a = node_[p.first], &b = node_[p.second];
+      links_[a.link_at + a.links++] = Link{p.second, weight(s, p.first, p.second)};
+      links_[b.link_at + b.links++] = Link{p.first, weight(s, p.second, p.first)};
     }
   }
 
@@ -282,29 +366,32 @@ private:
     return true;
   }
 
-  // The cosine of the angle at which the spheres of cell c and of its
-  // neighbour across facet f cross: 1 where they only touch, -1 where one
-  // holds the other. For an infinite neighbour, its ball is the outer
-  // half-space of the hull facet.
-  float crossing(Ch c, int f, const std::vector<Ball> &ball) const {
-    Ch nb = c->neighbor(f);
-    const Ball &p = ball[c->info().w.local], &q = ball[nb->info().w.local];
+  // The cosine of the angle at which the sphere of the finite neighbour of
+  // infinite cell c (across its hull facet, opposite vertex k, the
+  // infinite one) crosses the outer half-space of that facet: the finite
+  // cell's centre is h above the facet (outward), and the cosine -h / r.
+  float hull_crossing(Ch c, int k) const {
+    Ch fin = c->neighbor(k);
+    const int fi = fin->index(c);
+    const Node &b = node_[fin->info().w.local];
+    double nrm[3];
+    if (!outward_normal(fin, fi, nrm))
+      return 0;
+    const Point &a = fin->vertex((fi + 1) % 4)->point();
+    const double h = nrm[0] * (b.o[0] - a.x()) + nrm[1] * (b.o[1] - a.y()) +
+                     nrm[2] * (b.o[2] - a.z());
+    return float(std::max(-1.0, std::min(1.0, -h / std::sqrt(double(b.r2)))));
+  }
+
+  // The cosine of the angle at which the spheres of cells i and j,
+  // neighbours, cross: 1 where they only touch, -1 where one holds the
+  // other. An infinite cell's ball is the outer half-space of its hull
+  // facet (see hull_crossing()).
+  static float crossing(const Node &p, const Node &q) {
     if (p.r2 < 0 && q.r2 < 0)
       return -1;
-    if (p.r2 < 0 || q.r2 < 0) {
-      // The finite cell's centre, h above the hull facet (outward): the
-      // crossing is at the angle whose cosine is -h / r.
-      Ch fin = p.r2 < 0 ? nb : c;
-      const Ball &b = p.r2 < 0 ? q : p;
-      const int fi = p.r2 < 0 ? nb->index(c) : f;
-      double nrm[3];
-      if (!outward_normal(fin, fi, nrm))
-        return 0;
-      const Point &a = fin->vertex((fi + 1) % 4)->point();
-      const double h = nrm[0] * (b.o[0] - a.x()) + nrm[1] * (b.o[1] - a.y()) +
-                       nrm[2] * (b.o[2] - a.z());
-      return float(std::max(-1.0, std::min(1.0, -h / std::sqrt(double(b.r2)))));
-    }
+    if (p.r2 < 0 || q.r2 < 0)
+      return p.r2 < 0 ? p.o[0] : q.o[0];
     float d2 = 0;
     for (int k = 0; k < 3; ++k)
       d2 += (p.o[k] - q.o[k]) * (p.o[k] - q.o[k]);
@@ -429,8 +516,43 @@ private:
     std::vector<Ch> &inc = star_;
     inc.clear();
     dt_.incident_cells(v, std::back_inserter(inc));
-    // In an order that depends on the vertices only, not on the memory
-    // (each cell's key made once).
+    const size_t k = inc.size();
+    std::vector<uint32_t> &parent = parent_;
+    auto find = [&](uint32_t x) {
+      while (parent[x] != x)
+        x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    // The pieces of each label about v, joined across the facets at v, by
+    // union-find over the cells in inc's order (each root the first of its
+    // piece).
+    int pieces[3];
+    auto join = [&] {
+      for (size_t i = 0; i < k; ++i)
+        inc[i]->info().w.local = uint32_t(i);
+      parent.resize(k);
+      std::iota(parent.begin(), parent.end(), 0u);
+      for (size_t i = 0; i < k; ++i) {
+        Ch c = inc[i];
+        for (int f = 0; f < 4; ++f) {
+          Ch nb = c->neighbor(f);
+          if (c->vertex(f) == v || nb->info().w.label != c->info().w.label)
+            continue;
+          uint32_t a = find(uint32_t(i)), b = find(nb->info().w.local);
+          if (a != b)
+            parent[std::max(a, b)] = std::min(a, b);
+        }
+      }
+      pieces[0] = pieces[1] = pieces[2] = 0;
+      for (size_t i = 0; i < k; ++i)
+        if (find(uint32_t(i)) == i)
+          ++pieces[inc[i]->info().w.label];
+    };
+    join();
+    if (pieces[kInside] <= 1 && pieces[kOutside] <= 1)
+      return true; // most vertices: nothing to move
+    // Which piece moves is decided in an order that depends on the
+    // vertices only, not on the memory (each cell's key made once).
     keyed_.clear();
     for (Ch c : inc)
       keyed_.emplace_back(cell_key(c), c);
@@ -439,45 +561,20 @@ private:
                  const std::pair<std::array<uint32_t, 4>, Ch> &b) {
                 return a.first < b.first;
               });
-    for (size_t i = 0; i < inc.size(); ++i)
-      inc[i] = keyed_[i].second;
-    const size_t k = inc.size();
     for (size_t i = 0; i < k; ++i)
-      inc[i]->info().w.local = uint32_t(i);
-    std::vector<uint32_t> &parent = parent_;
-    parent.resize(k);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](uint32_t x) {
-      while (parent[x] != x)
-        x = parent[x] = parent[parent[x]];
-      return x;
-    };
-    for (size_t i = 0; i < k; ++i) {
-      Ch c = inc[i];
-      for (int f = 0; f < 4; ++f) {
-        Ch nb = c->neighbor(f);
-        if (c->vertex(f) == v || nb->info().w.label != c->info().w.label)
-          continue;
-        uint32_t a = find(uint32_t(i)), b = find(nb->info().w.local);
-        if (a != b)
-          parent[std::max(a, b)] = std::min(a, b);
-      }
-    }
+      inc[i] = keyed_[i].second;
+    join();
     std::vector<uint32_t> &size = size_;
     size.assign(k, 0);
     std::vector<uint8_t> &fixed = fixed_;
     fixed.assign(k, 0);
-    int pieces[3] = {0, 0, 0};
     for (size_t i = 0; i < k; ++i) {
       uint32_t r = find(uint32_t(i));
-      if (size[r]++ == 0)
-        ++pieces[inc[r]->info().w.label];
+      ++size[r];
       const CellLabel &w = inc[i]->info().w;
       if (dt_.is_infinite(inc[i]) || w.moved >= max_moves)
         fixed[r] = 1;
     }
-    if (pieces[kInside] <= 1 && pieces[kOutside] <= 1)
-      return true;
     uint32_t pick = UINT32_MAX;
     bool pick_split = false;
     for (size_t i = 0; i < k; ++i) {
@@ -523,7 +620,14 @@ private:
   std::vector<std::pair<std::array<uint32_t, 4>, Ch>> keyed_; // likewise
   std::vector<uint32_t> parent_, size_;
   std::vector<uint8_t> fixed_;
-  std::vector<Poles> poles_; // by vertex number, while weigh() runs
+  // While weigh() runs: by cell number, what it reads of each cell; the
+  // pole links, and the hull samples' evidence for inside (to their
+  // second poles).
+  std::vector<Node> node_;
+  std::vector<Link> links_;
+  std::vector<Link> hull_poles_;
+  std::vector<Ch> cells_;       // number -> handle
+  std::vector<uint32_t> kmin_;  // number -> smallest vertex number
 };
 
 } // namespace
