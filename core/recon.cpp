@@ -245,9 +245,9 @@ void Recon::patch_surface(const double *lxyz, size_t m, bool cut,
     surf.tris = open;
     surf.tris.insert(surf.tris.end(), closed_part.begin(), closed_part.end());
     append_edges_of(*table, m, surf.tris, open.size() / 3, progress);
-  } else if (cutting) {
+  } else if (cutting && !closed_part.empty()) {
     table = new_edge_table(); // the open part's alone: not surf.tris's
-  }
+  } // (with no closed part, open is surf.tris, and its table stays)
   // The surface was described after extraction, and cutting handles only
   // takes triangles out of open components: no component to flip, and
   // describe() runs once the holes are filled.
