@@ -236,10 +236,15 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
     fprintf(f, ", %llu handle%s cut", (unsigned long long)d->handles_cut,
             d->handles_cut == 1 ? "" : "s");
   fprintf(f, ".\n");
-  fprintf(f, "Path %s: %llu boundary sample%s, longest loop %llu edges.\n",
+  fprintf(f, "Path %s: %llu boundary sample%s, longest loop %llu edges",
           sc_path_name(d->path), (unsigned long long)d->boundary_samples,
           d->boundary_samples == 1 ? "" : "s",
           (unsigned long long)d->longest_loop);
+  if (d->labelled)
+    fprintf(f, "; cells labelled, %s", d->path == SC_PATH_WATERTIGHT_FILL
+                                           ? "the patches' closure kept"
+                                           : "their closure kept");
+  fprintf(f, ".\n");
   fprintf(f, "Noise: %.2f spacings (spacing %.3g)", d->noise, d->spacing);
   if (d->denoised)
     fprintf(f, "; denoised%s at scale %.3g, samples moved %.2f spacings "

@@ -131,6 +131,7 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   Surface a;
   sc_diag_t da = diag;
   auto label = [&] {
+    da.labelled = 1;
     // The triangulation that filter() kept; or, where it went after the
     // candidates (--patches), built again over the same points, numbered
     // as the surface's vertices are.
@@ -191,8 +192,10 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     return !c.ok || c.loops > 0 || pieces != 1 || diag.handles_cut > 0 ||
            1000 * c.unused > m;
   };
-  if ((labels_only || (patches_first ? !Closure(diag).ok : doubtful())) &&
-      label()) {
+  const bool labelling =
+      labels_only || (patches_first ? !Closure(diag).ok : doubtful());
+  diag.labelled = labelling;
+  if (labelling && label()) {
     if (labels_only || !Closure(diag).better_than(Closure(da)))
       take_labels();
   } else if (labels_only) {

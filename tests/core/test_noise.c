@@ -168,6 +168,7 @@ int main(int argc, char **argv) {
              (unsigned long long)d->samples_attached,
              (unsigned long long)d->samples_unused, sc_path_name(m->diag.path));
       if (settled) {
+        EXPECT_EQ(m->diag.labelled, 0);
         EXPECT_EQ(m->diag.path, d->path);
         EXPECT(mp->triangle_count == m->triangle_count &&
                memcmp(mp->triangles, m->triangles,
