@@ -9,11 +9,58 @@
 #include <array>
 #include <cmath>
 #include <numeric>
-#include <queue>
 
 namespace sc {
 namespace dt {
 namespace {
+
+// A priority queue on a heap of four children a node: half the depth of a
+// binary heap, so half the places a sift reads at random in a large queue.
+// later(a, b): a comes out after b.
+template <class T, class Later> class QuadHeap {
+public:
+  QuadHeap(Later later, size_t reserve) : later_(later) { v_.reserve(reserve); }
+  bool empty() const { return v_.empty(); }
+  const T &top() const { return v_[0]; }
+  void push(const T &x) {
+    size_t i = v_.size();
+    v_.push_back(x);
+    while (i > 0) {
+      const size_t up = (i - 1) / 4;
+      if (!later_(v_[up], x))
+        break;
+      v_[i] = v_[up];
+      i = up;
+    }
+    v_[i] = x;
+  }
+  void pop() {
+    const T x = v_.back();
+    v_.pop_back();
+    const size_t n = v_.size();
+    if (n == 0)
+      return;
+    size_t i = 0;
+    for (;;) {
+      const size_t first = 4 * i + 1;
+      if (first >= n)
+        break;
+      size_t next = first;
+      for (size_t k = first + 1; k < std::min(first + 4, n); ++k)
+        if (later_(v_[next], v_[k]))
+          next = k;
+      if (!later_(x, v_[next]))
+        break;
+      v_[i] = v_[next];
+      i = next;
+    }
+    v_[i] = x;
+  }
+
+private:
+  std::vector<T> v_;
+  Later later_;
+};
 
 // The labelling of one triangulation, and the scratch of its repair.
 template <class DT> class Labelling {
@@ -117,10 +164,8 @@ private:
         return a.prio < b.prio;
       return a.cell != b.cell && key_less(b.cell, a.cell);
     };
-    std::vector<Entry> entries;
-    entries.reserve(n / 2); // the most measured at once: about a third
-    std::priority_queue<Entry, std::vector<Entry>, decltype(later)> queue(
-        later, std::move(entries));
+    // The most entries measured at once: about a third of the cells.
+    QuadHeap<Entry, decltype(later)> queue(later, n / 2);
     for (size_t i = 0; i < n; ++i)
       if (node_[i].r2 < 0) {
         node_[i].eout = 2; // above any weight
