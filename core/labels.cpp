@@ -184,10 +184,16 @@ private:
     while (!queue.empty()) {
       const Entry e = queue.top();
       queue.pop();
+      // The cells are visited all over the triangulation: ask for the next
+      // one, and for this one's neighbours, before reading them.
+      if (!queue.empty())
+        __builtin_prefetch(&node_[queue.top().cell]);
       const uint32_t i = e.cell;
       Node &d = node_[i];
       if (d.label != kUnlabelled || e.prio != priority(d))
         continue; // labelled already, or its evidence has grown since
+      for (int f = 0; f < 4; ++f)
+        __builtin_prefetch(&node_[d.nbr[f]]);
       if ((++done & 0xFFFF) == 0)
         progress.tick(3, 4);
       d.label = d.ein > d.eout ? kInside : kOutside;
