@@ -293,7 +293,7 @@ private:
   void find_poles() {
     const size_t m = vh_.size();
     std::vector<Poles> poles(m);
-    // Hull facets, in the order of their numbers (the sums below are of
+    // Hull facets, in the order of their keys (the sums below are of
     // floats): each one's outward normal goes to its three samples.
     std::vector<uint32_t> hull;
     for (uint32_t i = 0; i < node_.size(); ++i)
@@ -434,8 +434,8 @@ private:
     return float(std::max(-1.0, std::min(1.0, -h / std::sqrt(double(b.r2)))));
   }
 
-  // The cosine of the angle at which the spheres of cells i and j,
-  // neighbours, cross: 1 where they only touch, -1 where one holds the
+  // The cosine of the angle at which the spheres of neighbouring cells p
+  // and q cross: 1 where they only touch, -1 where one holds the
   // other. An infinite cell's ball is the outer half-space of its hull
   // facet (see hull_crossing()).
   static float crossing(const Node &p, const Node &q) {

@@ -132,9 +132,9 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   sc_diag_t da = diag;
   auto label = [&] {
     da.labelled = 1;
-    // The triangulation that filter() kept; or, where it went after the
-    // candidates (--patches), built again over the same points, numbered
-    // as the surface's vertices are.
+    // The triangulation that filter() kept (--labels); or, where it went
+    // after the candidates (by default), built again over the same points,
+    // numbered as the surface's vertices are.
     std::unique_ptr<Triangulator> dt = std::move(kept_);
     if (!dt) {
       double box[6];
