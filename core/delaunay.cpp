@@ -284,8 +284,8 @@ public:
       std::memcpy(&out.poles[3 * size_t(v->info().idx)], v->info().pole,
                   sizeof v->info().pole);
     // The triangulation is not needed any more: free it before pruning so
-    // that the peak memory is the triangulation's alone (watertight mode
-    // keeps it for the labelling, which would otherwise build it again).
+    // that the peak memory is the triangulation's alone (watertight mode's
+    // labelling alone keeps it, where it would otherwise build it again).
     if (!keep)
       dt_.clear();
     // Which cell reports a facet, and when, depends on heap addresses; the
