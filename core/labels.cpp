@@ -491,6 +491,10 @@ private:
     const uint64_t budget = 64 * uint64_t(work.size()) + 10000;
     uint64_t steps = 0;
     bool gave_up = false;
+    // Most vertices need nothing; those are found at once (fine_links()),
+    // and repair_vertex() looks only at the others and at the vertices of
+    // cells that moved.
+    std::vector<uint8_t> fine = fine_links(m);
     // Rounds: a vertex at which no piece may move waits for the next round,
     // which allows more moves per cell.
     std::vector<Vh> unresolved, moved;
@@ -507,12 +511,16 @@ private:
         Vh v = work.back();
         work.pop_back();
         queued[v->info().idx] = 0;
+        if (fine[v->info().idx])
+          continue;
         moved.clear();
         if (!repair_vertex(v, max_moves, moved, diag))
           unresolved.push_back(v);
         std::sort(moved.begin(), moved.end(), [](Vh a, Vh b) {
           return a->info().idx < b->info().idx;
         });
+        for (Vh u : moved)
+          fine[u->info().idx] = 0;
         for (Vh u : moved)
           if (!queued[u->info().idx]) {
             queued[u->info().idx] = 1;
@@ -521,6 +529,80 @@ private:
       }
     }
     (void)gave_up;
+  }
+
+  // Per vertex, whether the facets between inside and other cells about it
+  // make one simple cycle in its link (each link vertex on two of them,
+  // all joined). The link of a vertex is a sphere (infinite cells
+  // included) whose triangles are the vertex's cells: two regions of a
+  // sphere, joined across edges, are each one piece exactly when the
+  // edges between them make one simple cycle. So a vertex marked here is
+  // one that repair_vertex() would leave as it is.
+  std::vector<uint8_t> fine_links(size_t m) const {
+    // The link edges (a, b) of each vertex v, from each facet (v, a, b).
+    auto each = [&](auto &&take) {
+      for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
+           ++c) {
+        if (c->info().w.label != kInside)
+          continue;
+        for (int f = 0; f < 4; ++f) {
+          if (c->neighbor(f)->info().w.label == kInside)
+            continue;
+          uint32_t t[3];
+          for (int j = 0; j < 3; ++j)
+            t[j] = c->vertex((f + 1 + j) % 4)->info().idx;
+          take(t[0], t[1], t[2]);
+          take(t[1], t[2], t[0]);
+          take(t[2], t[0], t[1]);
+        }
+      }
+    };
+    std::vector<uint32_t> at(m + 1, 0);
+    each([&](uint32_t v, uint32_t, uint32_t) { ++at[v + 1]; });
+    for (size_t v = 0; v < m; ++v)
+      at[v + 1] += at[v];
+    std::vector<std::array<uint32_t, 2>> edge(at[m]);
+    {
+      std::vector<uint32_t> put(at.begin(), at.end() - 1);
+      each([&](uint32_t v, uint32_t a, uint32_t b) {
+        edge[put[v]++] = {a, b};
+      });
+    }
+    std::vector<uint8_t> fine(m, 0);
+    std::vector<uint32_t> ends;
+    for (size_t v = 0; v < m; ++v) {
+      const std::array<uint32_t, 2> *e = edge.data() + at[v];
+      const size_t k = at[v + 1] - at[v];
+      if (k < 3)
+        continue;
+      // Every link vertex on exactly two of the edges...
+      ends.clear();
+      for (size_t i = 0; i < k; ++i)
+        ends.insert(ends.end(), e[i].begin(), e[i].end());
+      std::sort(ends.begin(), ends.end());
+      bool two = true;
+      for (size_t i = 0; i < ends.size() && two; i += 2)
+        two = ends[i] == ends[i + 1] &&
+              (i + 2 == ends.size() || ends[i + 2] != ends[i]);
+      if (!two)
+        continue;
+      // ... and all of them on one cycle: walk it from the first edge.
+      size_t steps = 1, last = 0;
+      uint32_t at_end = e[0][1];
+      while (at_end != e[0][0] && steps <= k) {
+        size_t next = k;
+        for (size_t i = 0; i < k && next == k; ++i)
+          if (i != last && (e[i][0] == at_end || e[i][1] == at_end))
+            next = i;
+        if (next == k)
+          break;
+        at_end = e[next][0] == at_end ? e[next][1] : e[next][0];
+        last = next;
+        ++steps;
+      }
+      fine[v] = at_end == e[0][0] && steps == k;
+    }
+    return fine;
   }
 
   // The boundary of the inside cells, each triangle facing out of them.
