@@ -519,13 +519,13 @@ private:
         std::sort(moved.begin(), moved.end(), [](Vh a, Vh b) {
           return a->info().idx < b->info().idx;
         });
-        for (Vh u : moved)
-          fine[u->info().idx] = 0;
-        for (Vh u : moved)
+        for (Vh u : moved) {
+          fine[u->info().idx] = 0; // its star changed
           if (!queued[u->info().idx]) {
             queued[u->info().idx] = 1;
             work.push_back(u);
           }
+        }
       }
     }
     (void)gave_up;
@@ -541,21 +541,11 @@ private:
   std::vector<uint8_t> fine_links(size_t m) const {
     // The link edges (a, b) of each vertex v, from each facet (v, a, b).
     auto each = [&](auto &&take) {
-      for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end();
-           ++c) {
-        if (c->info().w.label != kInside)
-          continue;
-        for (int f = 0; f < 4; ++f) {
-          if (c->neighbor(f)->info().w.label == kInside)
-            continue;
-          uint32_t t[3];
-          for (int j = 0; j < 3; ++j)
-            t[j] = c->vertex((f + 1 + j) % 4)->info().idx;
-          take(t[0], t[1], t[2]);
-          take(t[1], t[2], t[0]);
-          take(t[2], t[0], t[1]);
-        }
-      }
+      for_each_interface([&](Ch, int, const uint32_t t[3]) {
+        take(t[0], t[1], t[2]);
+        take(t[1], t[2], t[0]);
+        take(t[2], t[0], t[1]);
+      });
     };
     std::vector<uint32_t> at(m + 1, 0);
     each([&](uint32_t v, uint32_t, uint32_t) { ++at[v + 1]; });
@@ -605,9 +595,10 @@ private:
     return fine;
   }
 
-  // The boundary of the inside cells, each triangle facing out of them.
-  std::vector<uint32_t> boundary_of_inside() const {
-    std::vector<uint32_t> res;
+  // Calls take(c, f, t) for each facet f of an inside cell c whose
+  // neighbour is not inside, t its vertex numbers (vertices f + 1, f + 2,
+  // f + 3 of c).
+  template <class Take> void for_each_interface(Take &&take) const {
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
       if (c->info().w.label != kInside)
         continue;
@@ -617,12 +608,21 @@ private:
         uint32_t t[3];
         for (int j = 0; j < 3; ++j)
           t[j] = c->vertex((f + 1 + j) % 4)->info().idx;
-        // Outward: the cell's own fourth vertex must be behind.
-        if (front(t, c->vertex(f)))
-          std::swap(t[1], t[2]);
-        res.insert(res.end(), t, t + 3);
+        take(Ch(c), f, t);
       }
     }
+  }
+
+  // The boundary of the inside cells, each triangle facing out of them.
+  std::vector<uint32_t> boundary_of_inside() const {
+    std::vector<uint32_t> res;
+    for_each_interface([&](Ch c, int f, const uint32_t t[3]) {
+      uint32_t o[3] = {t[0], t[1], t[2]};
+      // Outward: the cell's own fourth vertex must be behind.
+      if (front(o, c->vertex(f)))
+        std::swap(o[1], o[2]);
+      res.insert(res.end(), o, o + 3);
+    });
     return res;
   }
 
