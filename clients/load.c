@@ -452,7 +452,7 @@ static void usage(FILE *f) {
       "      --mode MODE         cocone, shortcrust, boundary, watertight or "
       "auto\n"
       "                          (default cocone)\n"
-      "      --r R               shortcrust parameter (default 0.18)\n"
+      "      --r R               shortcrust parameter (default 0.14)\n"
       "      --verify            check every mesh: indices in range and a\n"
       "                          manifold; closed, outward and of the right\n"
       "                          genus for the generated samples\n"

@@ -232,7 +232,7 @@ typedef struct sc_client_params {
   /* One of SC_CLIENT_MODE_*; default SC_CLIENT_MODE_COCONE. */
   int mode;
   /* The shortcrust parameter, in (0, 0.5); sent in every mode. Default
-   * 0.18, as in the core. */
+   * 0.14, as in the core. */
   double r;
   /* Cocone half-width in radians, in (0, pi/2); 0 (default) for the
    * daemon's default, pi/8. */

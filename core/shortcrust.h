@@ -221,7 +221,7 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     SC_RANGE_CLOSED, "a mode", FIXED, 'm', "mode", "MODE",                     \
     "cocone, shortcrust, boundary (scans with a boundary), watertight "        \
     "(close every hole) or auto")                                              \
-  X(r, double, REAL, 0.18, 0, 0.5, SC_RANGE_OPEN, "in (0, 0.5)", FIXED, 0,     \
+  X(r, double, REAL, 0.14, 0, 0.5, SC_RANGE_OPEN, "in (0, 0.5)", FIXED, 0,     \
     "r", "R", "shortcrust sampling parameter")                                 \
   X(cocone_theta, double, ANGLE, SC_PI / 8, 0, SC_PI / 2, SC_RANGE_OPEN,       \
     "in (0, pi/2)", FIXED, 0, "theta", "DEG", "cocone half-width")             \

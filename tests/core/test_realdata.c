@@ -4,7 +4,7 @@
  * with (almost) every sample a vertex, in the default mode or the one
  * named.
  *
- *   test_core_realdata FILE GENUS [cocone|watertight|auto]
+ *   test_core_realdata FILE GENUS [cocone|shortcrust|watertight|auto]
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -20,7 +20,9 @@
 
 int main(int argc, char **argv) {
   if (argc != 3 && argc != 4) {
-    fprintf(stderr, "usage: %s FILE GENUS [cocone|watertight|auto]\n", argv[0]);
+    fprintf(stderr,
+            "usage: %s FILE GENUS [cocone|shortcrust|watertight|auto]\n",
+            argv[0]);
     return 2;
   }
   sc_params_t p;
@@ -28,6 +30,8 @@ int main(int argc, char **argv) {
   if (argc == 4) {
     if (strcmp(argv[3], "cocone") == 0) {
       p.mode = SC_MODE_COCONE;
+    } else if (strcmp(argv[3], "shortcrust") == 0) {
+      p.mode = SC_MODE_SHORTCRUST;
     } else if (strcmp(argv[3], "watertight") == 0) {
       p.mode = SC_MODE_WATERTIGHT;
     } else if (strcmp(argv[3], "auto") == 0) {

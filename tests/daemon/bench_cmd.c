@@ -204,7 +204,7 @@ static double paced_job(const char *sock, const double *xyz, size_t n,
     return -1;
   scdt_job_t j;
   scdt_job_init(&j, 1, xyz, n);
-  j.r = 0.18; /* the command's default */
+  j.r = 0.14; /* the command's default */
   const uint64_t chunk = 4096;
   double t0 = bench_seconds();
   int rc = scdt_job_begin(c, &j);
