@@ -406,6 +406,8 @@ static void json_values(FILE *f, const sc_client_value_t *v, size_t n) {
 
 static void usage(FILE *f) {
   char sock[256];
+  sc_client_params_t def;
+  sc_client_params_init(&def);
   fprintf(
       f,
       "usage: shortcrust-load [--connect ADDR | --socket PATH] [--token-file "
@@ -452,7 +454,7 @@ static void usage(FILE *f) {
       "      --mode MODE         cocone, shortcrust, boundary, watertight or "
       "auto\n"
       "                          (default cocone)\n"
-      "      --r R               shortcrust parameter (default 0.14)\n"
+      "      --r R               shortcrust parameter (default %g)\n"
       "      --verify            check every mesh: indices in range and a\n"
       "                          manifold; closed, outward and of the right\n"
       "                          genus for the generated samples\n"
@@ -463,7 +465,7 @@ static void usage(FILE *f) {
       "Exit status: 0 every job done (and verified), 1 errors or "
       "verification\nfailures, 2 bad command line.\n",
       LOAD_SAMPLES, sc_client_default_socket(sock, sizeof sock), LOAD_RETRIES,
-      LOAD_RETRY_BACKOFF_MS);
+      LOAD_RETRY_BACKOFF_MS, def.r);
 }
 
 static int parse_u64(const char *opt, const char *arg, uint64_t min,

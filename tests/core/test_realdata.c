@@ -4,7 +4,7 @@
  * with (almost) every sample a vertex, in the default mode or the one
  * named.
  *
- *   test_core_realdata FILE GENUS [cocone|shortcrust|watertight|auto]
+ *   test_core_realdata FILE GENUS [MODE]    (a name of sc_mode_name())
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -20,23 +20,17 @@
 
 int main(int argc, char **argv) {
   if (argc != 3 && argc != 4) {
-    fprintf(stderr,
-            "usage: %s FILE GENUS [cocone|shortcrust|watertight|auto]\n",
-            argv[0]);
+    fprintf(stderr, "usage: %s FILE GENUS [MODE]\n", argv[0]);
     return 2;
   }
   sc_params_t p;
   sc_params_init(&p);
   if (argc == 4) {
-    if (strcmp(argv[3], "cocone") == 0) {
-      p.mode = SC_MODE_COCONE;
-    } else if (strcmp(argv[3], "shortcrust") == 0) {
-      p.mode = SC_MODE_SHORTCRUST;
-    } else if (strcmp(argv[3], "watertight") == 0) {
-      p.mode = SC_MODE_WATERTIGHT;
-    } else if (strcmp(argv[3], "auto") == 0) {
-      p.mode = SC_MODE_AUTO;
-    } else {
+    p.mode = SC_MODE_COUNT_;
+    for (int k = 0; k < SC_MODE_COUNT_; ++k)
+      if (strcmp(argv[3], sc_mode_name(k)) == 0)
+        p.mode = (sc_mode_t)k;
+    if (p.mode == SC_MODE_COUNT_) {
       fprintf(stderr, "unknown mode '%s'\n", argv[3]);
       return 2;
     }

@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "bench.h"
+#include "shortcrust.h"
 #include "shortcrust_files.h"
 #include "synth.h"
 
@@ -204,7 +205,9 @@ static double paced_job(const char *sock, const double *xyz, size_t n,
     return -1;
   scdt_job_t j;
   scdt_job_init(&j, 1, xyz, n);
-  j.r = 0.14; /* the command's default */
+  sc_params_t def; /* the command's defaults */
+  sc_params_init(&def);
+  j.r = def.r;
   const uint64_t chunk = 4096;
   double t0 = bench_seconds();
   int rc = scdt_job_begin(c, &j);
