@@ -245,6 +245,17 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
                                            ? "the patches' closure kept"
                                            : "their closure kept");
   fprintf(f, ".\n");
+  if (d->checked) {
+    fprintf(f,
+            "Check: the cocone test's surface on the same triangulation "
+            "has %llu component%s (%llu closed), genus %lld",
+            (unsigned long long)d->check_components,
+            d->check_components == 1 ? "" : "s",
+            (unsigned long long)d->check_closed_components,
+            (long long)d->check_genus);
+    fprintf(f, "%s.\n",
+            d->topology_doubt ? ": the topology is in doubt" : ", the same");
+  }
   fprintf(f, "Noise: %.2f spacings (spacing %.3g)", d->noise, d->spacing);
   if (d->denoised)
     fprintf(f, "; denoised%s at scale %.3g, samples moved %.2f spacings "
@@ -383,6 +394,20 @@ static void warn_sparse(const sc_cli_result_t *r) {
                  shown(r->output, "standard output"),
                  (unsigned long long)d->samples_unused,
                  (unsigned long long)d->delaunay_vertices);
+  /* Shortcrust mode's check (docs/algorithm.md section 6.5). */
+  if (d->topology_doubt)
+    sc_cli_error("warning: %s: the topology is in doubt: on the same "
+                 "triangulation the cocone test gives %llu component%s "
+                 "(%llu closed, genus %lld), the criteria with r = %g "
+                 "%llu (%llu closed, genus %lld); the sample may be too "
+                 "sparse for this r: compare --mode cocone, or a smaller --r",
+                 shown(r->output, "standard output"),
+                 (unsigned long long)d->check_components,
+                 d->check_components == 1 ? "" : "s",
+                 (unsigned long long)d->check_closed_components,
+                 (long long)d->check_genus, r->params.r,
+                 (unsigned long long)d->components,
+                 (unsigned long long)d->closed_components, (long long)d->genus);
 }
 
 int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,

@@ -90,17 +90,21 @@ template <class DT>
 void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
                        const sc_params_t &params, Progress &progress,
                        std::vector<uint32_t> &tris, sc_diag_t &diag,
-                       const Ownership *own) {
+                       const Ownership *own, std::vector<uint32_t> *check) {
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
   Criteria cr(params);
+  // The check's test: the cocone's (at every vertex: shortcrust mode
+  // detects no boundary).
+  Criteria cocone_cr(params);
+  cocone_cr.mode = SC_MODE_COCONE;
   const bool detect = detects_boundary(params.mode);
   size_t cells = dt.number_of_cells(), k = 0;
   V3 cc, P[3], poles[3], CP[4], Cpoles[4];
   bool interior[3] = {true, true, true}, Cinterior[4];
   int side1[3] = {0, 0, 0}, Cside[4] = {0, 0, 0, 0};
   uint32_t idx[3], Cidx[4];
-  const bool cocone = cr.mode == SC_MODE_COCONE;
+  const bool cocone = cr.mode == SC_MODE_COCONE || check;
   // A cell's circumcentre and four vertices, read once for the facets it
   // handles.
   auto load = [&](Ch c) {
@@ -147,11 +151,11 @@ void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
       V3 o = CP[f];
       other = dot(nrm, o - P[0]) > 0 ? -1.0 * nrm : nrm;
     }
-    if (is_candidate(cr, P, poles, interior, side1, cc, other, ray)) {
-      tris.push_back(idx[0]);
-      tris.push_back(idx[1]);
-      tris.push_back(idx[2]);
-    }
+    if (is_candidate(cr, P, poles, interior, side1, cc, other, ray))
+      tris.insert(tris.end(), idx, idx + 3);
+    if (check &&
+        is_candidate(cocone_cr, P, poles, interior, side1, cc, other, ray))
+      check->insert(check->end(), idx, idx + 3);
   };
   // Each facet between two finite cells is handled from the cell at the
   // lower address, which reads nothing of the other cell but its
@@ -184,13 +188,15 @@ template void select_candidates<DtSeq>(DtSeq &,
                                        std::vector<DtSeq::Cell_handle> &,
                                        const sc_params_t &, Progress &,
                                        std::vector<uint32_t> &, sc_diag_t &,
-                                       const Ownership *);
+                                       const Ownership *,
+                                       std::vector<uint32_t> *);
 #ifdef CGAL_LINKED_WITH_TBB
 template void select_candidates<DtPar>(DtPar &,
                                        std::vector<DtPar::Cell_handle> &,
                                        const sc_params_t &, Progress &,
                                        std::vector<uint32_t> &, sc_diag_t &,
-                                       const Ownership *);
+                                       const Ownership *,
+                                       std::vector<uint32_t> *);
 #endif
 
 } // namespace dt

@@ -10,9 +10,9 @@
 
 #include "delaunay.hpp"
 
+#include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/hilbert_sort.h>
 #include <CGAL/spatial_sort.h>
-#include <CGAL/Spatial_sort_traits_adapter_3.h>
 #ifdef CGAL_LINKED_WITH_TBB
 #include <tbb/task_arena.h>
 #endif
@@ -273,7 +273,8 @@ public:
     seconds[SC_STAGE_POLES] += sw.lap();
 
     progress.stage(SC_STAGE_CANDIDATES);
-    select_candidates(dt_, infinite_, params, progress, out.tris, diag);
+    select_candidates(dt_, infinite_, params, progress, out.tris, diag, nullptr,
+                      params.mode == SC_MODE_SHORTCRUST ? &out.check : nullptr);
     diag.candidates = out.tris.size() / 3;
     // The unit poles by vertex number, for the normals: copied out last, so
     // that the array takes memory that boundary detection has freed instead
@@ -292,6 +293,7 @@ public:
     // later stages break ties by the order of the candidates. They carry no
     // orientation: the walk gives them one.
     canonical_order(out.tris, false);
+    canonical_order(out.check, false);
     seconds[SC_STAGE_CANDIDATES] += sw.lap();
   }
 

@@ -85,6 +85,9 @@ struct Filtered {
   // for the others; empty when boundary detection did not run, or found
   // too few interior samples to tell (then taken as closed: section 5.5).
   std::vector<uint8_t> boundary;
+  // Shortcrust mode: the facets that pass the cocone test, for the check of
+  // the topology (section 6.5); empty in the other modes.
+  std::vector<uint32_t> check;
 };
 
 // A boundary sample whose pole disagrees with its neighbours', and one
@@ -385,6 +388,10 @@ private:
                      Progress &progress, Surface &surf, sc_diag_t &diag);
   void patch_surface(const double *lxyz, size_t m, bool cut, Progress &progress,
                      Surface &surf, sc_diag_t &diag);
+  // Shortcrust mode: the cocone test's surface from f.check, compared with
+  // the one in diag (section 6.5); frees f.check.
+  void check_topology(const double *lxyz, size_t m, Filtered &f,
+                      Progress &progress, sc_diag_t &diag) const;
   // Denoising (section 16): whether insertion waits for finish(); the
   // estimate and the smoothing, which set work_ (xyz_, or smoothed_).
   bool defer_insertion() const;

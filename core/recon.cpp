@@ -653,6 +653,8 @@ sc_mesh_t *Recon::finish() {
 
   if (diag.delaunay_cells == 1 && m == 4)
     single_cell_surface(lxyz.data(), progress, surf, diag);
+  else if (params_.mode == SC_MODE_SHORTCRUST && !f.check.empty())
+    check_topology(lxyz.data(), m, f, progress, diag);
 
   std::vector<double> acc = vertex_normals(lxyz, m, surf.tris, f.poles);
   // Back to input indices.
@@ -668,6 +670,30 @@ sc_mesh_t *Recon::finish() {
   // like a surface this mode can reconstruct (PROTOCOL.md 6.9).
   diag.mostly_unused = 2 * diag.samples_unused > diag.delaunay_vertices;
   return result(surf, normals, diag, progress);
+}
+
+// Shortcrust mode's check (section 6.5): the surface that the cocone test
+// gives on the same triangulation, through the same pruning and walk, and
+// whether its topology is the same.
+void Recon::check_topology(const double *lxyz, size_t m, Filtered &f,
+                           Progress &progress, sc_diag_t &diag) const {
+  sc_diag_t cd;
+  std::memset(&cd, 0, sizeof cd);
+  std::vector<uint8_t> alive;
+  EdgeTablePtr table;
+  prune(lxyz, m, f.check, params_.paper_pruning != 0, f.boundary, alive, table,
+        progress, cd);
+  Surface cs;
+  extract(lxyz, m, f.check, alive, std::move(table),
+          size_t(params_.max_hole_edges), f.boundary, true, progress, cs, cd);
+  f.check = {};
+  diag.checked = 1;
+  diag.check_components = cd.components;
+  diag.check_closed_components = cd.closed_components;
+  diag.check_genus = cd.genus;
+  diag.topology_doubt = cd.components != diag.components ||
+                        cd.closed_components != diag.closed_components ||
+                        cd.genus != diag.genus;
 }
 
 // With smoothed_vertices, every point's smoothed position goes with the

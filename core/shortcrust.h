@@ -456,7 +456,20 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
   X(labelled, int, , BOOL, "labelled",                                         \
     "watertight: 1 when the Delaunay cells were labelled inside or outside "   \
     "for a closure (the patches left doubt, or watertight_labels); path "      \
-    "watertight-fill then means that the patches' closure was kept")
+    "watertight-fill then means that the patches' closure was kept")           \
+  X(checked, int, , BOOL, "checked",                                           \
+    "shortcrust: 1 when the surface was checked against the one the cocone "   \
+    "test gives on the same triangulation, else 0 (other modes, tile jobs)")   \
+  X(check_components, uint64_t, , COUNT, "check_components",                   \
+    "shortcrust: components of the cocone test's surface")                     \
+  X(check_closed_components, uint64_t, , COUNT, "check_closed_components",     \
+    "shortcrust: its components without boundary")                             \
+  X(check_genus, int64_t, , INT, "check_genus",                                \
+    "shortcrust: the sum of the genera of its closed components")              \
+  X(topology_doubt, int, , BOOL, "topology_doubt",                             \
+    "shortcrust: 1 when the two surfaces differ in components, closed "        \
+    "components or genus: the sample is too sparse for r, or for one of "      \
+    "the tests, to be sure of the topology")
 
 typedef struct sc_diag {
 #define SC_DIAG_FIELD_(field, type, dim, kind, wire, help) type field dim;

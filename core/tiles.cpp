@@ -359,7 +359,7 @@ struct Tile {
   // tiles of many points, a byte each would add up).
   std::vector<bool> member;
   std::vector<Ch> infinite;
-  std::vector<uint32_t> tris;
+  std::vector<uint32_t> tris, check; // candidates; the check's (shortcrust)
   // Within a memory limit: the vertex numbers of the tile's final
   // triangulation, its own and the foreign ones certification took, kept
   // between its two passes.
@@ -1282,7 +1282,8 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
       if (!own(v->info().idx))
         std::memcpy(v->info().pole, &out.poles[3 * size_t(v->info().idx)],
                     sizeof v->info().pole);
-    select_candidates(t.dt, t.infinite, params, p, t.tris, t.diag, &own);
+    select_candidates(t.dt, t.infinite, params, p, t.tris, t.diag, &own,
+                      params.mode == SC_MODE_SHORTCRUST ? &t.check : nullptr);
     drop(t);
   };
   if (bounded) {
@@ -1337,19 +1338,25 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                  [&](size_t i, Progress &p) { candidates(ts[i], p); });
   }
 
-  size_t total = 0;
-  for (const Tile &t : ts)
+  size_t total = 0, checks = 0;
+  for (const Tile &t : ts) {
     total += t.tris.size();
+    checks += t.check.size();
+  }
   out.tris.reserve(total);
+  out.check.reserve(checks);
   for (Tile &t : ts) {
     out.tris.insert(out.tris.end(), t.tris.begin(), t.tris.end());
+    out.check.insert(out.check.end(), t.check.begin(), t.check.end());
     t.tris = {};
+    t.check = {};
     t.diag.tile_points_foreign = t.foreign;
     add_tile_counts(diag, t.diag);
   }
   diag.tiles = k;
   diag.candidates = out.tris.size() / 3;
   canonical_order(out.tris, false);
+  canonical_order(out.check, false);
   seconds[SC_STAGE_CANDIDATES] += sw.lap();
   return true;
 }

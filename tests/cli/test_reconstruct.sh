@@ -180,6 +180,22 @@ grep -q "^shortcrust: warning: .*the mesh is empty" "$tmp/err" || fail "an empty
 grep -q '"mostly_unused": true' "$tmp/five.json" || fail "report lacks \"mostly_unused\": true"
 rm -f "$tmp/tet.xyz" "$tmp/tet.off" "$tmp/five.xyz" "$tmp/five.off" "$tmp/five.json"
 
+# Shortcrust mode checks its topology against the cocone test's surface
+# (docs/algorithm.md section 6.5): at r = 0.18 the knot opens with genus
+# 31, said on stderr even with --quiet, and in the report; at the default
+# r it is right, and the check agrees.
+expect 0 "Check: .*genus 1: the topology is in doubt" \
+  "$sc" reconstruct "$knot" -o "$tmp/k18.off" --mode shortcrust --r 0.18
+grep -q "^shortcrust: warning: .*the topology is in doubt: .*cocone test gives 1 component (1 closed, genus 1)" "$tmp/err" ||
+  fail "a wrong topology without a warning: $(cat "$tmp/err")"
+expect 0 "" "$sc" reconstruct "$knot" -o "$tmp/k18.off" --mode shortcrust --r 0.18 --quiet --report "$tmp/k18.json"
+grep -q "topology is in doubt" "$tmp/err" || fail "--quiet hides the doubt"
+grep -q '"topology_doubt": true' "$tmp/k18.json" || fail "report lacks \"topology_doubt\": true"
+expect 0 "Check: .*genus 1, the same" \
+  "$sc" reconstruct "$knot" -o "$tmp/k14.off" --mode shortcrust
+[ -s "$tmp/err" ] && fail "a right topology with a warning: $(cat "$tmp/err")"
+rm -f "$tmp/k18.off" "$tmp/k18.json" "$tmp/k14.off"
+
 echo "keep" > "$tmp/old.ply"
 expect 1 "missing.ply" "$sc" reconstruct "$tmp/missing.ply" -o "$tmp/old.ply"
 expect 1 "scan.laz: LAZ (compressed LAS) is not supported: decompress it first" \

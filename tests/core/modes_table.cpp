@@ -337,10 +337,14 @@ int measure(const std::string &dir, const std::string &name, int repeat,
       continue;
     }
     const sc_mesh_t *mesh = meshes[m];
-    if (row(name.c_str(), methods[m].name, sc_path_name(mesh->diag.path),
-            pts.count, mesh->triangles, mesh->triangle_count, pts.xyz,
-            ref.get(), spacing, best[m], dt_seconds,
-            closed ? &expected : nullptr))
+    // Shortcrust mode's check (docs/algorithm.md section 6.5): the path
+    // says when it finds the topology in doubt.
+    const std::string shown =
+        std::string(sc_path_name(mesh->diag.path)) +
+        (mesh->diag.topology_doubt ? " (topology in doubt)" : "");
+    if (row(name.c_str(), methods[m].name, shown.c_str(), pts.count,
+            mesh->triangles, mesh->triangle_count, pts.xyz, ref.get(), spacing,
+            best[m], dt_seconds, closed ? &expected : nullptr))
       ++right[m];
     sc_mesh_free(meshes[m]);
   }

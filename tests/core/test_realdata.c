@@ -14,8 +14,8 @@
 #include <string.h>
 
 #include "diag.h"
-#include "shortcrust_files.h"
 #include "shortcrust.h"
+#include "shortcrust_files.h"
 #include "synth.h"
 
 int main(int argc, char **argv) {
@@ -68,6 +68,10 @@ int main(int argc, char **argv) {
   EXPECT_EQ(m->diag.genus, genus);
   EXPECT(m->diag.closed);
   EXPECT_DIAG_COUNTS(m->diag, c);
+  /* Right, so shortcrust mode's check finds no doubt (docs/algorithm.md
+   * section 6.5); the other modes make none. */
+  EXPECT_EQ(m->diag.checked, p.mode == SC_MODE_SHORTCRUST);
+  EXPECT_EQ(m->diag.topology_doubt, 0);
   scs_meshcheck_free(&c);
   sc_mesh_free(m);
   scf_points_free(&pts);

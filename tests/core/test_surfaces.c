@@ -114,6 +114,15 @@ int main(int argc, char **argv) {
                 (unsigned long long)c.boundary_edges);
   }
 
+  /* Shortcrust mode checks its topology against the cocone test's surface
+   * (docs/algorithm.md section 6.5): on these right results, no doubt. */
+  EXPECT_EQ(d->checked, mode == SC_MODE_SHORTCRUST);
+  EXPECT_EQ(d->topology_doubt, 0);
+  if (mode == SC_MODE_SHORTCRUST) {
+    EXPECT_EQ(d->check_components, d->components);
+    EXPECT_EQ(d->check_genus, d->genus);
+  }
+
   /* Vertices are samples, so they lie on the surface to rounding error. */
   scs_distcheck_t dc;
   if (scs_mesh_distance_check(surf, n, xyz, mesh->triangles,
