@@ -351,7 +351,11 @@ extern "C" uint64_t sc_estimate_bytes(uint64_t n) {
 extern "C" void sc_release_memory(void) {
 #ifdef CGAL_LINKED_WITH_TBB
   // CGAL's k-d trees (the noise estimate, the smoothing) keep their nodes
-  // in TBB's scalable allocator, which holds on to freed blocks.
+  // in TBB's scalable allocator, which holds on to freed blocks. The
+  // command reads the allocator's state without setting it up, and crashes
+  // in a process that has not yet allocated from it (a job that built no
+  // k-d tree): one allocation first sets it up.
+  scalable_free(scalable_malloc(1));
   (void)scalable_allocation_command(TBBMALLOC_CLEAN_ALL_BUFFERS, nullptr);
 #endif
 #ifdef __GLIBC__
