@@ -208,7 +208,11 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
   fprintf(f, " -> %llu triangles in %s, mode %s",
           (unsigned long long)d->triangles, shown(r->output, "standard output"),
           sc_mode_name(r->params.mode));
-  if (r->params.mode == SC_MODE_SHORTCRUST)
+  if (r->params.mode == SC_MODE_SHORTCRUST && d->checked &&
+      d->r_used != r->params.r)
+    fprintf(f, " (r = %g: at %g the topology was not the cocone test's)",
+            d->r_used, r->params.r);
+  else if (r->params.mode == SC_MODE_SHORTCRUST)
     fprintf(f, " (r = %g)", r->params.r);
   fprintf(f, ".\n");
   if (d->closed)
@@ -376,6 +380,19 @@ int sc_cli_job_read(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,
   return SC_EXIT_OK;
 }
 
+/* "2 components, 1 closed" or "1 closed component of genus 2". */
+static void topology_text(char *buf, size_t len, uint64_t components,
+                          uint64_t closed, int64_t genus) {
+  if (closed == components)
+    snprintf(buf, len, "%llu closed component%s of genus %lld",
+             (unsigned long long)components, components == 1 ? "" : "s",
+             (long long)genus);
+  else
+    snprintf(buf, len, "%llu component%s, %llu closed",
+             (unsigned long long)components, components == 1 ? "" : "s",
+             (unsigned long long)closed);
+}
+
 /* An empty mesh, or one that leaves most samples in no triangle, is
  * written like any other but must not pass for an ordinary result
  * (PROTOCOL.md 6.9): one warning line on stderr, even with --quiet. The
@@ -395,19 +412,21 @@ static void warn_sparse(const sc_cli_result_t *r) {
                  (unsigned long long)d->samples_unused,
                  (unsigned long long)d->delaunay_vertices);
   /* Shortcrust mode's check (docs/algorithm.md section 6.5). */
-  if (d->topology_doubt)
-    sc_cli_error("warning: %s: the topology is in doubt: on the same "
-                 "triangulation the cocone test gives %llu component%s "
-                 "(%llu closed, genus %lld), the criteria with r = %g "
-                 "%llu (%llu closed, genus %lld); the sample may be too "
-                 "sparse for this r: compare --mode cocone, or a smaller --r",
-                 shown(r->output, "standard output"),
-                 (unsigned long long)d->check_components,
-                 d->check_components == 1 ? "" : "s",
-                 (unsigned long long)d->check_closed_components,
-                 (long long)d->check_genus, r->params.r,
-                 (unsigned long long)d->components,
-                 (unsigned long long)d->closed_components, (long long)d->genus);
+  if (d->topology_doubt) {
+    char ours[128], theirs[128];
+    topology_text(ours, sizeof ours, d->components, d->closed_components,
+                  d->genus);
+    topology_text(theirs, sizeof theirs, d->check_components,
+                  d->check_closed_components, d->check_genus);
+    sc_cli_error("warning: %s: the topology is in doubt: the criteria with "
+                 "r = %g give %s where the cocone test, on the same "
+                 "triangulation, gives %s%s; the sample may be too sparse "
+                 "for the criteria: compare --mode cocone",
+                 shown(r->output, "standard output"), r->params.r, ours, theirs,
+                 d->check_closed_components == d->check_components
+                     ? ", and no r within 0.02 of it gives that surface"
+                     : "");
+  }
 }
 
 int sc_cli_job_write(const sc_cli_job_opts_t *o, sc_cli_progress_t *progress,

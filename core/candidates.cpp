@@ -84,13 +84,66 @@ bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles,
   return hi >= -lim && lo <= lim;
 }
 
+// The paper's criteria at the values of r next to the one asked for
+// (Checks): which is the least that a facet passes.
+class NearR {
+public:
+  explicit NearR(const sc_params_t &params) {
+    for (int k = 0; k < kNearR; ++k) {
+      sc_params_t p = params;
+      p.r = params.r + (k - kNearR / 2) * kNearStep;
+      // A value outside (0, 0.5) passes nothing.
+      const bool valid = p.r > 1e-9 && p.r < 0.5;
+      const Criteria c(p);
+      cos_theta1_[k] = valid ? c.cos_theta1 : HUGE_VAL;
+      tan_phi_[k] = valid ? c.tan_phi : -HUGE_VAL;
+    }
+  }
+  // The least k at which the facet passes both criteria, kNearR when it
+  // passes at none. The arithmetic is is_candidate()'s, so that at the
+  // middle value, r itself, the answer is exactly its answer.
+  int least(const V3 *P, const V3 *poles, V3 v1, V3 v2, bool ray) const {
+    V3 n = cross(P[1] - P[0], P[2] - P[0]);
+    const double n2 = norm2(n);
+    if (!(n2 > 0))
+      return kNearR;
+    n = (1 / std::sqrt(n2)) * n;
+    const double l0 = norm2(P[1] - P[2]), l1 = norm2(P[0] - P[2]),
+                 l2 = norm2(P[0] - P[1]);
+    const int s = l0 >= l1 ? (l0 >= l2 ? 0 : 2) : (l1 >= l2 ? 1 : 2);
+    const double c1 = std::fabs(dot(n, poles[s]));
+    V3 ct;
+    if (!tri_circumcentre(P[0], P[1], P[2], ct))
+      return kNearR;
+    const double R = std::sqrt(norm2(P[0] - ct)), h1 = dot(v1 - ct, n);
+    double lo, hi;
+    if (ray) {
+      const double d = dot(v2, n);
+      lo = d >= 0 ? h1 : -std::numeric_limits<double>::infinity();
+      hi = d >= 0 ? std::numeric_limits<double>::infinity() : h1;
+    } else {
+      const double h2 = dot(v2 - ct, n);
+      lo = std::min(h1, h2);
+      hi = std::max(h1, h2);
+    }
+    for (int k = 0; k < kNearR; ++k)
+      if (!(c1 < cos_theta1_[k]) && hi >= -R * tan_phi_[k] &&
+          lo <= R * tan_phi_[k])
+        return k;
+    return kNearR;
+  }
+
+private:
+  double cos_theta1_[kNearR], tan_phi_[kNearR];
+};
+
 } // namespace
 
 template <class DT>
 void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
                        const sc_params_t &params, Progress &progress,
                        std::vector<uint32_t> &tris, sc_diag_t &diag,
-                       const Ownership *own, std::vector<uint32_t> *check) {
+                       const Ownership *own, Checks *check) {
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
   Criteria cr(params);
@@ -98,6 +151,7 @@ void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
   // detects no boundary).
   Criteria cocone_cr(params);
   cocone_cr.mode = SC_MODE_COCONE;
+  const NearR near(params);
   const bool detect = detects_boundary(params.mode);
   size_t cells = dt.number_of_cells(), k = 0;
   V3 cc, P[3], poles[3], CP[4], Cpoles[4];
@@ -151,11 +205,19 @@ void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
       V3 o = CP[f];
       other = dot(nrm, o - P[0]) > 0 ? -1.0 * nrm : nrm;
     }
-    if (is_candidate(cr, P, poles, interior, side1, cc, other, ray))
+    if (!check) {
+      if (is_candidate(cr, P, poles, interior, side1, cc, other, ray))
+        tris.insert(tris.end(), idx, idx + 3);
+      return;
+    }
+    // Shortcrust mode with its check: the criteria once, at every r near.
+    const int least = near.least(P, poles, cc, other, ray);
+    if (least <= kNearR / 2)
       tris.insert(tris.end(), idx, idx + 3);
-    if (check &&
-        is_candidate(cocone_cr, P, poles, interior, side1, cc, other, ray))
-      check->insert(check->end(), idx, idx + 3);
+    if (least < kNearR)
+      check->near[least].insert(check->near[least].end(), idx, idx + 3);
+    if (is_candidate(cocone_cr, P, poles, interior, side1, cc, other, ray))
+      check->cocone.insert(check->cocone.end(), idx, idx + 3);
   };
   // Each facet between two finite cells is handled from the cell at the
   // lower address, which reads nothing of the other cell but its
@@ -188,15 +250,13 @@ template void select_candidates<DtSeq>(DtSeq &,
                                        std::vector<DtSeq::Cell_handle> &,
                                        const sc_params_t &, Progress &,
                                        std::vector<uint32_t> &, sc_diag_t &,
-                                       const Ownership *,
-                                       std::vector<uint32_t> *);
+                                       const Ownership *, Checks *);
 #ifdef CGAL_LINKED_WITH_TBB
 template void select_candidates<DtPar>(DtPar &,
                                        std::vector<DtPar::Cell_handle> &,
                                        const sc_params_t &, Progress &,
                                        std::vector<uint32_t> &, sc_diag_t &,
-                                       const Ownership *,
-                                       std::vector<uint32_t> *);
+                                       const Ownership *, Checks *);
 #endif
 
 } // namespace dt

@@ -274,7 +274,7 @@ public:
 
     progress.stage(SC_STAGE_CANDIDATES);
     select_candidates(dt_, infinite_, params, progress, out.tris, diag, nullptr,
-                      params.mode == SC_MODE_SHORTCRUST ? &out.check : nullptr);
+                      checks(params) ? &out.check : nullptr);
     diag.candidates = out.tris.size() / 3;
     // The unit poles by vertex number, for the normals: copied out last, so
     // that the array takes memory that boundary detection has freed instead
@@ -293,7 +293,7 @@ public:
     // later stages break ties by the order of the candidates. They carry no
     // orientation: the walk gives them one.
     canonical_order(out.tris, false);
-    canonical_order(out.check, false);
+    out.check.canonical();
     seconds[SC_STAGE_CANDIDATES] += sw.lap();
   }
 

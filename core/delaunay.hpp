@@ -261,14 +261,13 @@ void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
 // The candidate triangles (candidates.cpp), by vertex number, from the one
 // pass over the Delaunay facets; frees infinite.
 // With own, only the facets the tile owns are tested and counted. With
-// check (shortcrust mode), the facets that pass the cocone test go there
-// too: the surface they give is the shortcrust mode's check (section 6.5).
+// check (shortcrust mode), what its check needs goes there too (section
+// 6.5), not yet in canonical order.
 template <class DT>
 void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
                        const sc_params_t &params, Progress &progress,
                        std::vector<uint32_t> &tris, sc_diag_t &diag,
-                       const Ownership *own = nullptr,
-                       std::vector<uint32_t> *check = nullptr);
+                       const Ownership *own = nullptr, Checks *check = nullptr);
 
 // Watertight mode's labelling of the cells (labels.cpp): see
 // Triangulator::close().

@@ -72,6 +72,29 @@ private:
   sc_stage_t stage_ = SC_STAGE_INPUT;
 };
 
+// Shortcrust mode's check (docs/algorithm.md section 6.5), from the same
+// pass over the facets as the candidates: those that pass the cocone test,
+// and those that pass the paper's criteria at the values of r next to the
+// one asked for, r + (k - 2) kNearStep for k = 0 .. kNearR - 1: near[k]
+// holds the facets whose least passing one is the k-th. Vertex numbers,
+// each list in canonical order.
+constexpr int kNearR = 5;
+constexpr double kNearStep = 0.01;
+struct Checks {
+  std::vector<uint32_t> cocone;
+  std::vector<uint32_t> near[kNearR];
+  // The facets that pass the criteria at the k-th value, in canonical
+  // order.
+  std::vector<uint32_t> at(int k) const;
+  void append(Checks &&other);
+  void canonical();
+};
+// Whether a job runs shortcrust mode's check, and so its candidates stage
+// collects the lists above.
+inline bool checks(const sc_params_t &p) {
+  return p.mode == SC_MODE_SHORTCRUST && !p.unchecked;
+}
+
 // What the triangulation stages hand to the rest of the pipeline; the
 // triangulation itself is gone by then.
 // Vertices are numbered 0 .. m-1 in the triangulation's (spatially sorted)
@@ -85,9 +108,9 @@ struct Filtered {
   // for the others; empty when boundary detection did not run, or found
   // too few interior samples to tell (then taken as closed: section 5.5).
   std::vector<uint8_t> boundary;
-  // Shortcrust mode: the facets that pass the cocone test, for the check of
-  // the topology (section 6.5); empty in the other modes.
-  std::vector<uint32_t> check;
+  // Shortcrust mode: what its check needs (section 6.5); empty in the
+  // other modes.
+  Checks check;
 };
 
 // A boundary sample whose pole disagrees with its neighbours', and one
@@ -342,9 +365,10 @@ bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
 // The union of the results of every tile of such a job (tiles[i] by
 // tile_job(), its candidates and poles by input index): fills out as
 // tiled_filter() would. Throws SC_EINVALID_ARGUMENT for results that cannot
-// be one job's tiles.
+// be one job's tiles. check: shortcrust mode's check runs (checks()),
+// and the tiles carry its lists.
 void merge_tiles(const double *xyz, size_t n, const sc_mesh_t *const *tiles,
-                 size_t count, Filtered &out, sc_diag_t &diag);
+                 size_t count, bool check, Filtered &out, sc_diag_t &diag);
 } // namespace dt
 
 // Within a memory limit of `limit` bytes (section 17.5): the tiles n points
@@ -388,10 +412,13 @@ private:
                      Progress &progress, Surface &surf, sc_diag_t &diag);
   void patch_surface(const double *lxyz, size_t m, bool cut, Progress &progress,
                      Surface &surf, sc_diag_t &diag);
-  // Shortcrust mode: the cocone test's surface from f.check, compared with
-  // the one in diag (section 6.5); frees f.check.
+  // Shortcrust mode's check (section 6.5): the cocone test's surface,
+  // compared with surf (whose counts are in diag); where they differ, surf
+  // and diag become those of the nearest r that agrees, if one does.
+  // before: diag as it was before the pruning. Frees f.check.
   void check_topology(const double *lxyz, size_t m, Filtered &f,
-                      Progress &progress, sc_diag_t &diag) const;
+                      const sc_diag_t &before, Progress &progress,
+                      Surface &surf, sc_diag_t &diag) const;
   // Denoising (section 16): whether insertion waits for finish(); the
   // estimate and the smoothing, which set work_ (xyz_, or smoothed_).
   bool defer_insertion() const;

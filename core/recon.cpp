@@ -563,7 +563,7 @@ sc_mesh_t *Recon::finish() {
   for (size_t i = 0; i < merge_count_; ++i)
     merged = merged && merge_[i]->diag.tiles >= 2;
   if (merged)
-    dt::merge_tiles(work, n_, merge_, merge_count_, f, diag);
+    dt::merge_tiles(work, n_, merge_, merge_count_, checks(params_), f, diag);
   const bool tiled =
       merged || (!dt_ && tile_count() &&
                  dt::tiled_filter(work, n_, tile_count(), thread_count(),
@@ -609,6 +609,7 @@ sc_mesh_t *Recon::finish() {
   for (size_t k = 0; k < m; ++k)
     std::memcpy(&lxyz[3 * k], work + 3 * size_t(f.to_input[k]),
                 3 * sizeof(double));
+  const sc_diag_t before_prune = diag;
   std::vector<uint8_t> alive;
   EdgeTablePtr table;
   prune(lxyz.data(), m, f.tris, params_.paper_pruning != 0, f.boundary, alive,
@@ -653,8 +654,8 @@ sc_mesh_t *Recon::finish() {
 
   if (diag.delaunay_cells == 1 && m == 4)
     single_cell_surface(lxyz.data(), progress, surf, diag);
-  else if (params_.mode == SC_MODE_SHORTCRUST && !f.check.empty())
-    check_topology(lxyz.data(), m, f, progress, diag);
+  else if (params_.mode == SC_MODE_SHORTCRUST && !f.check.cocone.empty())
+    check_topology(lxyz.data(), m, f, before_prune, progress, surf, diag);
 
   std::vector<double> acc = vertex_normals(lxyz, m, surf.tris, f.poles);
   // Back to input indices.
@@ -672,28 +673,89 @@ sc_mesh_t *Recon::finish() {
   return result(surf, normals, diag, progress);
 }
 
+std::vector<uint32_t> Checks::at(int k) const {
+  std::vector<uint32_t> tris;
+  for (int j = 0; j <= k; ++j)
+    tris.insert(tris.end(), near[j].begin(), near[j].end());
+  canonical_order(tris, false);
+  return tris;
+}
+
+void Checks::append(Checks &&other) {
+  cocone.insert(cocone.end(), other.cocone.begin(), other.cocone.end());
+  other.cocone = {};
+  for (int k = 0; k < kNearR; ++k) {
+    near[k].insert(near[k].end(), other.near[k].begin(), other.near[k].end());
+    other.near[k] = {};
+  }
+}
+
+void Checks::canonical() {
+  canonical_order(cocone, false);
+  for (int k = 0; k < kNearR; ++k)
+    canonical_order(near[k], false);
+}
+
 // Shortcrust mode's check (section 6.5): the surface that the cocone test
 // gives on the same triangulation, through the same pruning and walk, and
-// whether its topology is the same.
+// whether its topology is the same; where it is not, the surfaces of the
+// nearest values of r, nearest first and the larger first, until one is
+// the cocone test's closed surface.
 void Recon::check_topology(const double *lxyz, size_t m, Filtered &f,
-                           Progress &progress, sc_diag_t &diag) const {
-  sc_diag_t cd;
-  std::memset(&cd, 0, sizeof cd);
-  std::vector<uint8_t> alive;
-  EdgeTablePtr table;
-  prune(lxyz, m, f.check, params_.paper_pruning != 0, f.boundary, alive, table,
-        progress, cd);
+                           const sc_diag_t &before, Progress &progress,
+                           Surface &surf, sc_diag_t &diag) const {
+  // One candidate set through pruning and the walk, into s and d.
+  auto surface = [&](const std::vector<uint32_t> &cand, Surface &s,
+                     sc_diag_t &d) {
+    std::vector<uint8_t> alive;
+    EdgeTablePtr table;
+    d.candidates = cand.size() / 3;
+    prune(lxyz, m, cand, params_.paper_pruning != 0, f.boundary, alive, table,
+          progress, d);
+    extract(lxyz, m, cand, alive, std::move(table),
+            size_t(params_.max_hole_edges), f.boundary, true, progress, s, d);
+  };
+  sc_diag_t cd = before;
   Surface cs;
-  extract(lxyz, m, f.check, alive, std::move(table),
-          size_t(params_.max_hole_edges), f.boundary, true, progress, cs, cd);
-  f.check = {};
+  surface(f.check.cocone, cs, cd);
+  f.check.cocone = {};
   diag.checked = 1;
+  diag.r_used = params_.r;
   diag.check_components = cd.components;
   diag.check_closed_components = cd.closed_components;
   diag.check_genus = cd.genus;
-  diag.topology_doubt = cd.components != diag.components ||
-                        cd.closed_components != diag.closed_components ||
-                        cd.genus != diag.genus;
+  auto same = [&](const sc_diag_t &d) {
+    return d.components == cd.components &&
+           d.closed_components == cd.closed_components && d.genus == cd.genus;
+  };
+  diag.topology_doubt = !same(diag);
+  // Only a closed surface of the cocone test is worth looking for: where
+  // it is open, it is in doubt itself.
+  if (diag.topology_doubt && cd.closed) {
+    const int mid = kNearR / 2;
+    for (int step = 1; step <= mid; ++step)
+      for (int k : {mid + step, mid - step}) {
+        const double r = params_.r + (k - mid) * kNearStep;
+        if (!(r > 1e-9 && r < 0.5))
+          continue;
+        sc_diag_t d = before;
+        Surface s;
+        surface(f.check.at(k), s, d);
+        if (!same(d) || !d.closed)
+          continue;
+        d.checked = 1;
+        d.r_used = r;
+        d.check_components = cd.components;
+        d.check_closed_components = cd.closed_components;
+        d.check_genus = cd.genus;
+        d.topology_doubt = 0;
+        diag = d;
+        surf = std::move(s);
+        f.check = Checks();
+        return;
+      }
+  }
+  f.check = Checks();
 }
 
 // With smoothed_vertices, every point's smoothed position goes with the
@@ -729,9 +791,29 @@ sc_mesh_t *Recon::finish_tile(const double *work, Progress &progress,
   if (dt::tile_job(work, n_, size_t(params_.tile_count),
                    size_t(params_.tile_index), tile_margin(), params_, progress,
                    f, diag, seconds_)) {
-    surf.tris.reserve(f.tris.size());
-    for (uint32_t v : f.tris)
-      surf.tris.push_back(f.to_input[v]);
+    // Triangles by input index, each run in canonical order (PROTOCOL.md
+    // section 6.3, tile jobs).
+    auto add = [&](const std::vector<uint32_t> &tris) {
+      std::vector<uint32_t> in(tris.size());
+      for (size_t k = 0; k < tris.size(); ++k)
+        in[k] = f.to_input[tris[k]];
+      canonical_order(in, false);
+      surf.tris.insert(surf.tris.end(), in.begin(), in.end());
+    };
+    if (checks(params_)) {
+      // The candidates, by their least passing r, then the cocone test's.
+      uint64_t *runs[kNearR] = {&diag.tile_near_0, &diag.tile_near_1,
+                                &diag.tile_near_2, &diag.tile_near_3,
+                                &diag.tile_near_4};
+      for (int k = 0; k < kNearR; ++k) {
+        add(f.check.near[k]);
+        *runs[k] = f.check.near[k].size() / 3;
+      }
+      add(f.check.cocone);
+      diag.checked = 1;
+    } else {
+      add(f.tris);
+    }
     normals = normals_by_input(f.poles, f, n_);
   } else {
     diag.tiles = 0; // the merge runs the job on one triangulation

@@ -151,6 +151,11 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    surface. Ignored by the cocone test.
  *  - cocone_theta: half-width of the cocone around the plane normal to the
  *    pole: the cocone is |cos angle(y - s, pole)| <= cos(pi/2 - theta).
+ *  - unchecked: shortcrust mode checks its surface against the one the
+ *    cocone test gives on the same triangulation and, where their
+ *    topologies differ, takes the nearest r within 0.02 that gives the
+ *    cocone test's closed surface, or says that the topology is in doubt
+ *    (diag.topology_doubt; docs/algorithm.md section 6.5). 1 skips that.
  *  - paper_pruning: edges with a single candidate triangle. 0: such an edge
  *    is sharp only when its triangle hangs by it alone (two or more of its
  *    edges have no other candidate), so fins go but a hole left by a
@@ -225,6 +230,10 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "r", "R", "shortcrust sampling parameter")                                 \
   X(cocone_theta, double, ANGLE, SC_PI / 8, 0, SC_PI / 2, SC_RANGE_OPEN,       \
     "in (0, pi/2)", FIXED, 0, "theta", "DEG", "cocone half-width")             \
+  X(unchecked, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION, 0,       \
+    "unchecked", NULL,                                                         \
+    "shortcrust mode: skip the check of the topology against the cocone "      \
+    "test's surface, and the search of a nearby r (a tenth less time)")        \
   X(paper_pruning, int, FLAG, 0, 0, 1, SC_RANGE_CLOSED, "0 or 1", OPTION, 0,   \
     "paper-pruning", NULL,                                                     \
     "prune every edge with a single candidate, as in the paper")               \
@@ -459,7 +468,11 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
     "watertight-fill then means that the patches' closure was kept")           \
   X(checked, int, , BOOL, "checked",                                           \
     "shortcrust: 1 when the surface was checked against the one the cocone "   \
-    "test gives on the same triangulation, else 0 (other modes, tile jobs)")   \
+    "test gives on the same triangulation, else 0 (other modes); in a tile "   \
+    "job's result, 1 when its triangles carry what the check needs")           \
+  X(r_used, double, , REAL, "r_used",                                          \
+    "shortcrust: the r of the surface given: r, or the nearest value within "  \
+    "0.02 whose surface is the cocone test's closed one where r's is not")     \
   X(check_components, uint64_t, , COUNT, "check_components",                   \
     "shortcrust: components of the cocone test's surface")                     \
   X(check_closed_components, uint64_t, , COUNT, "check_closed_components",     \
@@ -469,7 +482,18 @@ int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
   X(topology_doubt, int, , BOOL, "topology_doubt",                             \
     "shortcrust: 1 when the two surfaces differ in components, closed "        \
     "components or genus: the sample is too sparse for r, or for one of "      \
-    "the tests, to be sure of the topology")
+    "the tests, to be sure of the topology")                                   \
+  X(tile_near_0, uint64_t, , COUNT, "tile_near_0",                             \
+    "shortcrust tile job with its check: of its triangles, the first this "    \
+    "many pass the criteria at r - 0.02")                                      \
+  X(tile_near_1, uint64_t, , COUNT, "tile_near_1",                             \
+    "the next this many pass them first at r - 0.01")                          \
+  X(tile_near_2, uint64_t, , COUNT, "tile_near_2",                             \
+    "the next this many first at r")                                           \
+  X(tile_near_3, uint64_t, , COUNT, "tile_near_3",                             \
+    "the next this many first at r + 0.01")                                    \
+  X(tile_near_4, uint64_t, , COUNT, "tile_near_4",                             \
+    "the next this many first at r + 0.02; the rest pass the cocone test")
 
 typedef struct sc_diag {
 #define SC_DIAG_FIELD_(field, type, dim, kind, wire, help) type field dim;

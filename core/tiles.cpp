@@ -359,7 +359,8 @@ struct Tile {
   // tiles of many points, a byte each would add up).
   std::vector<bool> member;
   std::vector<Ch> infinite;
-  std::vector<uint32_t> tris, check; // candidates; the check's (shortcrust)
+  std::vector<uint32_t> tris; // candidates
+  Checks check;               // shortcrust mode's (section 6.5)
   // Within a memory limit: the vertex numbers of the tile's final
   // triangulation, its own and the foreign ones certification took, kept
   // between its two passes.
@@ -1283,7 +1284,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
         std::memcpy(v->info().pole, &out.poles[3 * size_t(v->info().idx)],
                     sizeof v->info().pole);
     select_candidates(t.dt, t.infinite, params, p, t.tris, t.diag, &own,
-                      params.mode == SC_MODE_SHORTCRUST ? &t.check : nullptr);
+                      checks(params) ? &t.check : nullptr);
     drop(t);
   };
   if (bounded) {
@@ -1338,25 +1339,21 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                  [&](size_t i, Progress &p) { candidates(ts[i], p); });
   }
 
-  size_t total = 0, checks = 0;
-  for (const Tile &t : ts) {
+  size_t total = 0;
+  for (const Tile &t : ts)
     total += t.tris.size();
-    checks += t.check.size();
-  }
   out.tris.reserve(total);
-  out.check.reserve(checks);
   for (Tile &t : ts) {
     out.tris.insert(out.tris.end(), t.tris.begin(), t.tris.end());
-    out.check.insert(out.check.end(), t.check.begin(), t.check.end());
+    out.check.append(std::move(t.check));
     t.tris = {};
-    t.check = {};
     t.diag.tile_points_foreign = t.foreign;
     add_tile_counts(diag, t.diag);
   }
   diag.tiles = k;
   diag.candidates = out.tris.size() / 3;
   canonical_order(out.tris, false);
-  canonical_order(out.check, false);
+  out.check.canonical();
   seconds[SC_STAGE_CANDIDATES] += sw.lap();
   return true;
 }
@@ -1401,8 +1398,10 @@ bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
   seconds[SC_STAGE_POLES] += sw.lap();
 
   progress.stage(SC_STAGE_CANDIDATES);
-  select_candidates(t.dt, t.infinite, params, progress, out.tris, t.diag, &own);
+  select_candidates(t.dt, t.infinite, params, progress, out.tris, t.diag, &own,
+                    checks(params) ? &out.check : nullptr);
   canonical_order(out.tris, false);
+  out.check.canonical();
   t.diag.tile_points_foreign = t.foreign;
   add_tile_counts(diag, t.diag);
   diag.candidates = out.tris.size() / 3;
@@ -1412,7 +1411,7 @@ bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
 
 // See internal.hpp.
 void merge_tiles(const double *xyz, size_t n, const sc_mesh_t *const *tiles,
-                 size_t count, Filtered &out, sc_diag_t &diag) {
+                 size_t count, bool check, Filtered &out, sc_diag_t &diag) {
   std::vector<uint8_t> is_vertex(n, 0);
   distinct_points(xyz, n, is_vertex, out.dups);
   const std::vector<uint32_t> rank =
@@ -1421,22 +1420,63 @@ void merge_tiles(const double *xyz, size_t n, const sc_mesh_t *const *tiles,
   out.poles.assign(3 * m, 0.0);
   size_t total = 0;
   for (size_t i = 0; i < count; ++i)
-    total += 3 * tiles[i]->triangle_count;
+    total += 3 * std::min<size_t>(tiles[i]->triangle_count,
+                                  tiles[i]->diag.candidates);
   out.tris.reserve(total);
   char buf[200];
   for (size_t i = 0; i < count; ++i) {
     const sc_mesh_t &t = *tiles[i];
-    for (size_t k = 0; k < 3 * t.triangle_count; ++k) {
-      const uint32_t x = t.triangles[k];
-      if (x >= n || rank[x] == UINT32_MAX) {
+    if (bool(t.diag.checked) != check) {
+      std::snprintf(buf, sizeof buf,
+                    "tile %zu %s what shortcrust mode's check needs and the "
+                    "job %s: the results are not of this job's tiles",
+                    i, t.diag.checked ? "carries" : "lacks",
+                    check ? "runs it" : "does not");
+      throw Error(SC_EINVALID_ARGUMENT, buf);
+    }
+    // The runs of t's triangles: the candidates alone, or with the check,
+    // the facets by their least passing value of r, then the cocone test's.
+    size_t runs[kNearR + 1] = {size_t(t.triangle_count)};
+    if (check) {
+      const uint64_t near[kNearR] = {t.diag.tile_near_0, t.diag.tile_near_1,
+                                     t.diag.tile_near_2, t.diag.tile_near_3,
+                                     t.diag.tile_near_4};
+      uint64_t listed = 0;
+      for (int k = 0; k < kNearR; ++k)
+        listed += near[k];
+      if (listed > t.triangle_count ||
+          near[0] + near[1] + near[2] != t.diag.candidates) {
         std::snprintf(buf, sizeof buf,
-                      "tile %zu: triangle %zu has index %u, %s", i, k / 3,
-                      unsigned(x),
-                      x >= n ? "past the last point"
-                             : "a repeated point, which is no vertex");
+                      "tile %zu: its %zu triangles and %llu candidates are "
+                      "not the runs its tile_near counts say",
+                      i, t.triangle_count,
+                      (unsigned long long)t.diag.candidates);
         throw Error(SC_EINVALID_ARGUMENT, buf);
       }
-      out.tris.push_back(rank[x]);
+      for (int k = 0; k < kNearR; ++k)
+        runs[k] = size_t(near[k]);
+      runs[kNearR] = t.triangle_count - size_t(listed);
+    }
+    size_t k = 0;
+    for (int run = 0; run <= (check ? kNearR : 0); ++run) {
+      std::vector<uint32_t> &into = !check          ? out.tris
+                                    : run == kNearR ? out.check.cocone
+                                                    : out.check.near[run];
+      for (const size_t end = k + 3 * runs[run]; k < end; ++k) {
+        const uint32_t x = t.triangles[k];
+        if (x >= n || rank[x] == UINT32_MAX) {
+          std::snprintf(buf, sizeof buf,
+                        "tile %zu: triangle %zu has index %u, %s", i, k / 3,
+                        unsigned(x),
+                        x >= n ? "past the last point"
+                               : "a repeated point, which is no vertex");
+          throw Error(SC_EINVALID_ARGUMENT, buf);
+        }
+        into.push_back(rank[x]);
+      }
+      // The runs up to r's are the candidates.
+      if (check && run <= kNearR / 2)
+        out.tris.insert(out.tris.end(), into.end() - 3 * runs[run], into.end());
     }
     // Each tile sends the poles of the points it owns, zero for the others.
     if (t.normals)
@@ -1449,6 +1489,7 @@ void merge_tiles(const double *xyz, size_t n, const sc_mesh_t *const *tiles,
     diag.tiles = std::max<uint64_t>(diag.tiles, t.diag.tiles);
   }
   canonical_order(out.tris, false);
+  out.check.canonical();
   for (size_t k = 3; k < out.tris.size(); k += 3)
     if (std::equal(&out.tris[k - 3], &out.tris[k], &out.tris[k])) {
       std::snprintf(buf, sizeof buf,

@@ -10,7 +10,7 @@ trap 'rm -rf "$tmp"' EXIT
 
 knot=$data/knot1_points.ply
 expect 0 "usage: shortcrust reconstruct" "$sc" reconstruct --help
-for opt in --output --mode --r --theta --max-hole --paper-pruning --threads \
+for opt in --output --mode --r --theta --max-hole --paper-pruning --unchecked --threads \
            --denoise --denoise-scale --smoothed-vertices --tiles --memory-limit \
            --report --ascii --no-normals --quiet .las .laz; do
   grep -q -- "$opt" "$tmp/out" || fail "--help does not mention $opt"
@@ -186,7 +186,7 @@ rm -f "$tmp/tet.xyz" "$tmp/tet.off" "$tmp/five.xyz" "$tmp/five.off" "$tmp/five.j
 # r it is right, and the check agrees.
 expect 0 "Check: .*genus 1: the topology is in doubt" \
   "$sc" reconstruct "$knot" -o "$tmp/k18.off" --mode shortcrust --r 0.18
-grep -q "^shortcrust: warning: .*the topology is in doubt: .*cocone test gives 1 component (1 closed, genus 1)" "$tmp/err" ||
+grep -q "^shortcrust: warning: .*the topology is in doubt: .*criteria with r = 0.18 give 1 component, 0 closed where the cocone test, on the same triangulation, gives 1 closed component of genus 1" "$tmp/err" ||
   fail "a wrong topology without a warning: $(cat "$tmp/err")"
 expect 0 "" "$sc" reconstruct "$knot" -o "$tmp/k18.off" --mode shortcrust --r 0.18 --quiet --report "$tmp/k18.json"
 grep -q "topology is in doubt" "$tmp/err" || fail "--quiet hides the doubt"
@@ -194,7 +194,12 @@ grep -q '"topology_doubt": true' "$tmp/k18.json" || fail "report lacks \"topolog
 expect 0 "Check: .*genus 1, the same" \
   "$sc" reconstruct "$knot" -o "$tmp/k14.off" --mode shortcrust
 [ -s "$tmp/err" ] && fail "a right topology with a warning: $(cat "$tmp/err")"
-rm -f "$tmp/k18.off" "$tmp/k18.json" "$tmp/k14.off"
+expect 0 "mode shortcrust (r = 0.18)" \
+  "$sc" reconstruct "$knot" -o "$tmp/k18u.off" --mode shortcrust --r 0.18 --unchecked
+grep -q "^Check:" "$tmp/out" && fail "--unchecked still checks: $(cat "$tmp/out")"
+[ -s "$tmp/err" ] && fail "--unchecked still warns: $(cat "$tmp/err")"
+cmp -s "$tmp/k18.off" "$tmp/k18u.off" || fail "--unchecked changed the mesh"
+rm -f "$tmp/k18.off" "$tmp/k18u.off" "$tmp/k18.json" "$tmp/k14.off"
 
 echo "keep" > "$tmp/old.ply"
 expect 1 "missing.ply" "$sc" reconstruct "$tmp/missing.ply" -o "$tmp/old.ply"

@@ -76,6 +76,10 @@ static void same(const char *what, const sc_mesh_t *a, const sc_mesh_t *b,
   EXPECT_EQ(a->diag.hull_vertices, b->diag.hull_vertices);
   EXPECT_EQ(a->diag.candidates, b->diag.candidates);
   EXPECT_EQ(a->diag.genus, b->diag.genus);
+  /* Shortcrust mode's check saw the same, and chose the same r. */
+  EXPECT_EQ(a->diag.checked, b->diag.checked);
+  EXPECT_EQ(a->diag.topology_doubt, b->diag.topology_doubt);
+  EXPECT_EQ(a->diag.r_used, b->diag.r_used);
   printf("ok: %s: %zu triangles, %llu tiles, %llu points triangulated twice "
          "(%.0f%%)\n",
          tag, b->triangle_count, (unsigned long long)b->diag.tiles,
@@ -387,6 +391,41 @@ cancel : {
       sc_mesh_t *ref = run("torus", xyz, n, SC_MODE_COCONE, 1, 1);
       if (m && ref)
         same("torus, two tile jobs merged in reverse", ref, m, 2, 1);
+      sc_mesh_free(ref);
+      sc_mesh_free(m);
+    }
+    sc_mesh_free(parts[0]);
+    sc_mesh_free(parts[1]);
+    /* Shortcrust mode's tile results carry its check's runs: a merge of
+     * other parameters, or runs that do not add up, are refused. */
+    p.mode = SC_MODE_SHORTCRUST;
+    for (int i = 0; i < 2; ++i) {
+      p.tile_index = i;
+      EXPECT_EQ(sc_reconstruct(xyz, n, &p, &parts[i], msg, sizeof msg), SC_OK);
+    }
+    if (parts[0] && parts[1]) {
+      EXPECT_EQ(parts[0]->diag.checked, 1);
+      EXPECT_EQ(parts[0]->diag.tile_near_0 + parts[0]->diag.tile_near_1 +
+                    parts[0]->diag.tile_near_2,
+                parts[0]->diag.candidates);
+      EXPECT_GT(parts[0]->triangle_count, parts[0]->diag.candidates);
+      const sc_mesh_t *both[2] = {parts[0], parts[1]};
+      p.unchecked = 1;
+      EXPECT_EQ(sc_reconstruct_merge(xyz, n, &p, both, 2, &m, msg, sizeof msg),
+                SC_EINVALID_ARGUMENT);
+      EXPECT_NOT_NULL(strstr(msg, "carries what shortcrust mode's check"));
+      p.unchecked = 0;
+      parts[1]->diag.tile_near_4 += parts[1]->triangle_count;
+      EXPECT_EQ(sc_reconstruct_merge(xyz, n, &p, both, 2, &m, msg, sizeof msg),
+                SC_EINVALID_ARGUMENT);
+      EXPECT_NOT_NULL(strstr(msg, "tile_near counts"));
+      printf("ok: shortcrust tile results of another job refused: %s\n", msg);
+      parts[1]->diag.tile_near_4 -= parts[1]->triangle_count;
+      EXPECT_EQ(sc_reconstruct_merge(xyz, n, &p, both, 2, &m, msg, sizeof msg),
+                SC_OK);
+      sc_mesh_t *ref = run("torus", xyz, n, SC_MODE_SHORTCRUST, 1, 1);
+      if (m && ref)
+        same("torus, two shortcrust tile jobs merged", ref, m, 2, 1);
       sc_mesh_free(ref);
       sc_mesh_free(m);
     }
