@@ -25,6 +25,46 @@ inline int cone_side(V3 dir, V3 pole_unit, double sin2_cocone) {
   return d > 0 ? 1 : -1;
 }
 
+// What the paper's first criterion compares with cos theta: the unit
+// normal n of triangle P and c1 = |n . pole| at the vertex with the largest
+// angle, the one opposite the longest edge. False for a degenerate
+// triangle.
+bool normal_cosine(const V3 *P, const V3 *poles, V3 &n, double &c1) {
+  n = cross(P[1] - P[0], P[2] - P[0]);
+  const double n2 = norm2(n);
+  if (!(n2 > 0))
+    return false;
+  n = (1 / std::sqrt(n2)) * n;
+  const double l0 = norm2(P[1] - P[2]), l1 = norm2(P[0] - P[2]),
+               l2 = norm2(P[0] - P[1]);
+  const int s = l0 >= l1 ? (l0 >= l2 ? 0 : 2) : (l1 >= l2 ? 1 : 2);
+  c1 = std::fabs(dot(n, poles[s]));
+  return true;
+}
+
+// What the second compares with R tan phi: the circumradius R of triangle P
+// (unit normal n) and the heights [lo, hi] of its dual Voronoi edge (from
+// v1 to v2, or from v1 along v2 when `ray`) above its circumcentre. False
+// when the circumcentre is not defined.
+bool dual_heights(const V3 *P, V3 n, V3 v1, V3 v2, bool ray, double &R,
+                  double &lo, double &hi) {
+  V3 ct;
+  if (!tri_circumcentre(P[0], P[1], P[2], ct))
+    return false;
+  R = std::sqrt(norm2(P[0] - ct));
+  const double h1 = dot(v1 - ct, n);
+  if (ray) {
+    const double d = dot(v2, n);
+    lo = d >= 0 ? h1 : -std::numeric_limits<double>::infinity();
+    hi = d >= 0 ? std::numeric_limits<double>::infinity() : h1;
+  } else {
+    const double h2 = dot(v2 - ct, n);
+    lo = std::min(h1, h2);
+    hi = std::max(h1, h2);
+  }
+  return true;
+}
+
 // The candidate test for triangle abc with indices idx. The dual Voronoi
 // edge runs from v1 to v2, or from v1 along direction v2 when `ray`.
 // interior says which vertices the cocone test is made at: all three except
@@ -49,38 +89,17 @@ bool is_candidate(const Criteria &cr, const V3 *P, const V3 *poles,
     // cocone test).
     return norm2(cross(P[1] - P[0], P[2] - P[0])) > 0;
   }
-  V3 n = cross(P[1] - P[0], P[2] - P[0]);
-  double n2 = norm2(n);
-  if (!(n2 > 0))
+  // Criterion 1: the normal at the vertex with the largest angle.
+  V3 n;
+  double c1;
+  if (!normal_cosine(P, poles, n, c1) || c1 < cr.cos_theta1)
     return false;
-  n = (1 / std::sqrt(n2)) * n;
-
-  // Criterion 1: the normal at the vertex with the largest angle, which is
-  // the vertex opposite the longest edge.
-  double l0 = norm2(P[1] - P[2]), l1 = norm2(P[0] - P[2]),
-         l2 = norm2(P[0] - P[1]);
-  int s = l0 >= l1 ? (l0 >= l2 ? 0 : 2) : (l1 >= l2 ? 1 : 2);
-  if (std::fabs(dot(n, poles[s])) < cr.cos_theta1)
-    return false;
-
   // Criterion 2: the dual edge's height interval above the triangle's
   // circumcentre must meet [-R tan phi, R tan phi].
-  V3 ct;
-  if (!tri_circumcentre(P[0], P[1], P[2], ct))
+  double R, lo, hi;
+  if (!dual_heights(P, n, v1, v2, ray, R, lo, hi))
     return false;
-  double R = std::sqrt(norm2(P[0] - ct));
-  double lim = R * cr.tan_phi;
-  double h1 = dot(v1 - ct, n);
-  double lo, hi;
-  if (ray) {
-    double d = dot(v2, n);
-    lo = d >= 0 ? h1 : -std::numeric_limits<double>::infinity();
-    hi = d >= 0 ? std::numeric_limits<double>::infinity() : h1;
-  } else {
-    double h2 = dot(v2 - ct, n);
-    lo = std::min(h1, h2);
-    hi = std::max(h1, h2);
-  }
+  const double lim = R * cr.tan_phi;
   return hi >= -lim && lo <= lim;
 }
 
@@ -91,41 +110,22 @@ public:
   explicit NearR(const sc_params_t &params) {
     for (int k = 0; k < kNearR; ++k) {
       sc_params_t p = params;
-      p.r = params.r + (k - kNearR / 2) * kNearStep;
-      // A value outside (0, 0.5) passes nothing.
-      const bool valid = p.r > 1e-9 && p.r < 0.5;
+      p.r = Checks::r_at(params.r, k);
+      const bool valid = p.r > 0;
       const Criteria c(p);
       cos_theta1_[k] = valid ? c.cos_theta1 : HUGE_VAL;
       tan_phi_[k] = valid ? c.tan_phi : -HUGE_VAL;
     }
   }
   // The least k at which the facet passes both criteria, kNearR when it
-  // passes at none. The arithmetic is is_candidate()'s, so that at the
+  // passes at none. The measures are is_candidate()'s, so that at the
   // middle value, r itself, the answer is exactly its answer.
   int least(const V3 *P, const V3 *poles, V3 v1, V3 v2, bool ray) const {
-    V3 n = cross(P[1] - P[0], P[2] - P[0]);
-    const double n2 = norm2(n);
-    if (!(n2 > 0))
+    V3 n;
+    double c1, R, lo, hi;
+    if (!normal_cosine(P, poles, n, c1) ||
+        !dual_heights(P, n, v1, v2, ray, R, lo, hi))
       return kNearR;
-    n = (1 / std::sqrt(n2)) * n;
-    const double l0 = norm2(P[1] - P[2]), l1 = norm2(P[0] - P[2]),
-                 l2 = norm2(P[0] - P[1]);
-    const int s = l0 >= l1 ? (l0 >= l2 ? 0 : 2) : (l1 >= l2 ? 1 : 2);
-    const double c1 = std::fabs(dot(n, poles[s]));
-    V3 ct;
-    if (!tri_circumcentre(P[0], P[1], P[2], ct))
-      return kNearR;
-    const double R = std::sqrt(norm2(P[0] - ct)), h1 = dot(v1 - ct, n);
-    double lo, hi;
-    if (ray) {
-      const double d = dot(v2, n);
-      lo = d >= 0 ? h1 : -std::numeric_limits<double>::infinity();
-      hi = d >= 0 ? std::numeric_limits<double>::infinity() : h1;
-    } else {
-      const double h2 = dot(v2 - ct, n);
-      lo = std::min(h1, h2);
-      hi = std::max(h1, h2);
-    }
     for (int k = 0; k < kNearR; ++k)
       if (!(c1 < cos_theta1_[k]) && hi >= -R * tan_phi_[k] &&
           lo <= R * tan_phi_[k])

@@ -88,6 +88,12 @@ struct Checks {
   std::vector<uint32_t> at(int k) const;
   void append(Checks &&other);
   void canonical();
+  // The k-th value, r + (k - 2) kNearStep; 0 where that is outside
+  // (0, 0.5), where the criteria pass nothing.
+  static double r_at(double r, int k) {
+    const double v = r + (k - kNearR / 2) * kNearStep;
+    return v > 1e-9 && v < 0.5 ? v : 0;
+  }
 };
 // Whether a job runs shortcrust mode's check, and so its candidates stage
 // collects the lists above.

@@ -719,36 +719,35 @@ void Recon::check_topology(const double *lxyz, size_t m, Filtered &f,
   Surface cs;
   surface(f.check.cocone, cs, cd);
   f.check.cocone = {};
-  diag.checked = 1;
-  diag.r_used = params_.r;
-  diag.check_components = cd.components;
-  diag.check_closed_components = cd.closed_components;
-  diag.check_genus = cd.genus;
   auto same = [&](const sc_diag_t &d) {
     return d.components == cd.components &&
            d.closed_components == cd.closed_components && d.genus == cd.genus;
   };
-  diag.topology_doubt = !same(diag);
+  // What the check says of a surface d given by the criteria at r.
+  auto report = [&](sc_diag_t &d, double r) {
+    d.checked = 1;
+    d.r_used = r;
+    d.check_components = cd.components;
+    d.check_closed_components = cd.closed_components;
+    d.check_genus = cd.genus;
+    d.topology_doubt = !same(d);
+  };
+  report(diag, params_.r);
   // Only a closed surface of the cocone test is worth looking for: where
   // it is open, it is in doubt itself.
   if (diag.topology_doubt && cd.closed) {
     const int mid = kNearR / 2;
     for (int step = 1; step <= mid; ++step)
       for (int k : {mid + step, mid - step}) {
-        const double r = params_.r + (k - mid) * kNearStep;
-        if (!(r > 1e-9 && r < 0.5))
+        const double r = Checks::r_at(params_.r, k);
+        if (!(r > 0))
           continue;
         sc_diag_t d = before;
         Surface s;
         surface(f.check.at(k), s, d);
         if (!same(d) || !d.closed)
           continue;
-        d.checked = 1;
-        d.r_used = r;
-        d.check_components = cd.components;
-        d.check_closed_components = cd.closed_components;
-        d.check_genus = cd.genus;
-        d.topology_doubt = 0;
+        report(d, r);
         diag = d;
         surf = std::move(s);
         f.check = Checks();
