@@ -90,24 +90,33 @@ static void same(const char *what, const sc_mesh_t *a, const sc_mesh_t *b,
 
 /* The job split into k tile jobs, each run alone as on another machine,
  * and merged (sc_reconstruct_merge()); tile jobs in reverse order. */
+/* Tile jobs 0 .. k-1 of p's job (p->tile_count set to k) into parts, from
+ * the last: 1 when every one ran. */
+static int tile_jobs(const char *what, const double *xyz, size_t n,
+                     sc_params_t *p, int k, sc_mesh_t **parts) {
+  char msg[256] = "";
+  int ok = 1;
+  p->tile_count = k;
+  for (int i = k - 1; i >= 0; --i) {
+    p->tile_index = i;
+    int rc = sc_reconstruct(xyz, n, p, &parts[i], msg, sizeof msg);
+    if (rc != 0) {
+      EXPECT_FAIL("%s, %s, tile %d of %d: %s: %s", what, sc_mode_name(p->mode),
+                  i, k, sc_err_name(rc), msg);
+      ok = 0;
+    }
+  }
+  return ok;
+}
+
 static sc_mesh_t *run_apart(const char *what, const double *xyz, size_t n,
                             sc_mode_t mode, int k) {
   sc_mesh_t *parts[16] = {NULL};
   sc_params_t p;
   sc_params_init(&p);
   p.mode = mode;
-  p.tile_count = k;
   char msg[256] = "";
-  int ok = 1;
-  for (int i = k - 1; i >= 0; --i) {
-    p.tile_index = i;
-    int rc = sc_reconstruct(xyz, n, &p, &parts[i], msg, sizeof msg);
-    if (rc != 0) {
-      EXPECT_FAIL("%s, %s, tile %d of %d: %s: %s", what, sc_mode_name(mode), i,
-                  k, sc_err_name(rc), msg);
-      ok = 0;
-    }
-  }
+  const int ok = tile_jobs(what, xyz, n, &p, k, parts);
   sc_mesh_t *mesh = NULL;
   if (ok) {
     int rc = sc_reconstruct_merge(xyz, n, &p, (const sc_mesh_t *const *)parts,
@@ -119,6 +128,22 @@ static sc_mesh_t *run_apart(const char *what, const double *xyz, size_t n,
   for (int i = 0; i < k; ++i)
     sc_mesh_free(parts[i]);
   return mesh;
+}
+
+/* Tile results merged: the mesh of one triangulation in p's mode. */
+static void merged_same(const char *tag, const double *xyz, size_t n,
+                        const sc_params_t *p, const sc_mesh_t *const *parts,
+                        int k) {
+  sc_mesh_t *m = NULL;
+  char msg[256] = "";
+  EXPECT_EQ(
+      sc_reconstruct_merge(xyz, n, p, parts, (size_t)k, &m, msg, sizeof msg),
+      SC_OK);
+  sc_mesh_t *ref = run(tag, xyz, n, p->mode, 1, 1);
+  if (m && ref)
+    same(tag, ref, m, k, 1);
+  sc_mesh_free(ref);
+  sc_mesh_free(m);
 }
 
 static void check(const char *what, const double *xyz, size_t n) {
@@ -354,11 +379,7 @@ cancel : {
     EXPECT_NOT_NULL(strstr(msg, "cocone and shortcrust modes only"));
     p.mode = SC_MODE_COCONE;
     sc_mesh_t *parts[2] = {NULL, NULL}, *m = NULL;
-    for (int i = 0; i < 2; ++i) {
-      p.tile_index = i;
-      EXPECT_EQ(sc_reconstruct(xyz, n, &p, &parts[i], msg, sizeof msg), SC_OK);
-    }
-    if (parts[0] && parts[1]) {
+    if (tile_jobs("torus", xyz, n, &p, 2, parts)) {
       EXPECT_EQ(parts[0]->diag.tiles, 2);
       EXPECT_EQ(parts[0]->component_count, 0);
       EXPECT_GT(parts[0]->triangle_count, 0);
@@ -386,24 +407,15 @@ cancel : {
       printf("ok: a broken tile result refused: %s\n", msg);
       parts[1]->triangles[4] = keep;
       /* In any order, the untiled mesh. */
-      EXPECT_EQ(sc_reconstruct_merge(xyz, n, &p, both, 2, &m, msg, sizeof msg),
-                SC_OK);
-      sc_mesh_t *ref = run("torus", xyz, n, SC_MODE_COCONE, 1, 1);
-      if (m && ref)
-        same("torus, two tile jobs merged in reverse", ref, m, 2, 1);
-      sc_mesh_free(ref);
-      sc_mesh_free(m);
+      merged_same("torus, two tile jobs merged in reverse", xyz, n, &p, both,
+                  2);
     }
     sc_mesh_free(parts[0]);
     sc_mesh_free(parts[1]);
     /* Shortcrust mode's tile results carry its check's runs: a merge of
      * other parameters, or runs that do not add up, are refused. */
     p.mode = SC_MODE_SHORTCRUST;
-    for (int i = 0; i < 2; ++i) {
-      p.tile_index = i;
-      EXPECT_EQ(sc_reconstruct(xyz, n, &p, &parts[i], msg, sizeof msg), SC_OK);
-    }
-    if (parts[0] && parts[1]) {
+    if (tile_jobs("torus", xyz, n, &p, 2, parts)) {
       EXPECT_EQ(parts[0]->diag.checked, 1);
       EXPECT_EQ(parts[0]->diag.tile_near_0 + parts[0]->diag.tile_near_1 +
                     parts[0]->diag.tile_near_2,
@@ -421,13 +433,8 @@ cancel : {
       EXPECT_NOT_NULL(strstr(msg, "tile_near counts"));
       printf("ok: shortcrust tile results of another job refused: %s\n", msg);
       parts[1]->diag.tile_near_4 -= parts[1]->triangle_count;
-      EXPECT_EQ(sc_reconstruct_merge(xyz, n, &p, both, 2, &m, msg, sizeof msg),
-                SC_OK);
-      sc_mesh_t *ref = run("torus", xyz, n, SC_MODE_SHORTCRUST, 1, 1);
-      if (m && ref)
-        same("torus, two shortcrust tile jobs merged", ref, m, 2, 1);
-      sc_mesh_free(ref);
-      sc_mesh_free(m);
+      merged_same("torus, two shortcrust tile jobs merged", xyz, n, &p, both,
+                  2);
     }
     sc_mesh_free(parts[0]);
     sc_mesh_free(parts[1]);
