@@ -31,12 +31,11 @@ test-sanitize: setup
 	cd $(BUILD)-asan && ctest --output-on-failure -j $(JOBS) -LE slow
 
 # ThreadSanitizer build of the threaded code's fast tests: the daemon's pool,
-# the clients and the core's tiles on two threads (TBB, under the parallel
-# triangulation, is not instrumented, so the rest of the core stays out).
+# the clients, and the core's tiles and smoothing on several threads.
 test-tsan: setup
 	cmake -S . -B $(BUILD)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSC_SANITIZE=thread
 	cmake --build $(BUILD)-tsan -j $(JOBS)
-	cd $(BUILD)-tsan && ctest --output-on-failure -j $(JOBS) -LE slow -R '^(daemon|clients)_|^core_tiles_threads$$'
+	cd $(BUILD)-tsan && ctest --output-on-failure -j $(JOBS) -LE slow -R '^(daemon|clients)_|^core_tiles_threads$$|^core_api$$|^core_noise_'
 
 # The protocol decoder and the file readers under libFuzzer, ASan and UBSan
 # (clang), for FUZZ_SECONDS each.

@@ -319,11 +319,6 @@ void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
 template void classify<DtSeq>(DtSeq &, const std::vector<DtSeq::Cell_handle> &,
                               const sc_params_t &, Progress &,
                               std::vector<uint8_t> &, sc_diag_t &);
-#ifdef CGAL_LINKED_WITH_TBB
-template void classify<DtPar>(DtPar &, const std::vector<DtPar::Cell_handle> &,
-                              const sc_params_t &, Progress &,
-                              std::vector<uint8_t> &, sc_diag_t &);
-#endif
 
 } // namespace dt
 } // namespace sc

@@ -251,13 +251,6 @@ template void select_candidates<DtSeq>(DtSeq &,
                                        const sc_params_t &, Progress &,
                                        std::vector<uint32_t> &, sc_diag_t &,
                                        const Ownership *, Checks *);
-#ifdef CGAL_LINKED_WITH_TBB
-template void select_candidates<DtPar>(DtPar &,
-                                       std::vector<DtPar::Cell_handle> &,
-                                       const sc_params_t &, Progress &,
-                                       std::vector<uint32_t> &, sc_diag_t &,
-                                       const Ownership *, Checks *);
-#endif
 
 } // namespace dt
 } // namespace sc

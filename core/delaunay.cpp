@@ -13,9 +13,6 @@
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/hilbert_sort.h>
 #include <CGAL/spatial_sort.h>
-#ifdef CGAL_LINKED_WITH_TBB
-#include <tbb/task_arena.h>
-#endif
 
 #include <algorithm>
 #include <array>
@@ -383,47 +380,13 @@ private:
   HintGrid<Vh> grid_;
 };
 
-#ifdef CGAL_LINKED_WITH_TBB
-typedef CGAL::Spatial_lock_grid_3<CGAL::Tag_priority_blocking> LockGrid;
-
-// The lock grid must outlive the triangulation that points to it, so it sits
-// in a base class constructed first.
-struct LockHolder {
-  LockGrid lock;
-  tbb::task_arena arena;
-  LockHolder(const double *b, int threads)
-      : lock(CGAL::Bbox_3(b[0], b[1], b[2], b[3], b[4], b[5]), 50),
-        arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
-};
-
-class ParallelTriangulator final : private LockHolder,
-                                   public TriangulatorImpl<DtPar> {
-public:
-  ParallelTriangulator(const double *b, int threads)
-      : LockHolder(b, threads), TriangulatorImpl<DtPar>(K(), &lock) {}
-  // The arena bounds this job's threads without touching the process-wide
-  // TBB settings, so concurrent jobs can each have their own count.
-  void insert(const double *xyz, size_t first, size_t n,
-              Progress &progress) override {
-    arena.execute(
-        [&] { TriangulatorImpl<DtPar>::insert(xyz, first, n, progress); });
-  }
-};
-#endif
-
 } // namespace
 } // namespace dt
 
-std::unique_ptr<Triangulator> make_triangulator(int threads,
-                                                const double *bbox6) {
-#ifdef CGAL_LINKED_WITH_TBB
-  // The lock grid needs a box up front; points outside it (later chunks) are
-  // clamped to its border cells, which costs contention, not correctness.
-  if (threads != 1)
-    return std::make_unique<dt::ParallelTriangulator>(bbox6, threads);
-#endif
-  (void)threads;
-  (void)bbox6;
+// CGAL's concurrent triangulation was measured slower here than the
+// sequential one on every input and number of threads tried (docs/
+// algorithm.md section 3): the threads go to the tiles instead.
+std::unique_ptr<Triangulator> make_triangulator() {
   return std::make_unique<dt::TriangulatorImpl<dt::DtSeq>>();
 }
 

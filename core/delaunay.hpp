@@ -111,14 +111,6 @@ static_assert(std::is_same<TdsSeq::Cell_range::allocator_type,
                   std::is_same<TdsSeq::Vertex_range::allocator_type,
                                PrefaultAllocator<TdsSeq::Vertex>>::value,
               "the triangulation's blocks bypass PrefaultAllocator");
-#ifdef CGAL_LINKED_WITH_TBB
-typedef CGAL::Triangulation_data_structure_3<Vb, Cb, CGAL::Parallel_tag>
-    TdsPar;
-typedef CGAL::Delaunay_triangulation_3<
-    K, TdsPar, CGAL::Default,
-    CGAL::Spatial_lock_grid_3<CGAL::Tag_priority_blocking>>
-    DtPar;
-#endif
 
 struct V3 {
   double x, y, z;
@@ -236,8 +228,7 @@ struct Ownership {
   bool operator()(uint32_t vertex) const { return owner[vertex] == tile; }
 };
 
-// The stages, in the order delaunay.cpp runs them; each is instantiated for
-// the sequential and the parallel triangulation in its own file.
+// The stages, in the order delaunay.cpp runs them, each in its own file.
 
 // Poles (poles.cpp): each vertex's pole direction, unit, and each finite
 // cell's circumcentre (CellData::cc); infinite receives the infinite cells,

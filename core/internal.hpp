@@ -130,8 +130,8 @@ inline bool detects_boundary(int mode) {
          mode == SC_MODE_AUTO;
 }
 
-// The Delaunay-dependent stages, behind an interface so that the sequential
-// and the parallel triangulation share the rest of the pipeline.
+// The Delaunay-dependent stages, behind an interface that keeps CGAL's
+// types out of the rest of the pipeline.
 class Triangulator {
 public:
   virtual ~Triangulator() = default;
@@ -166,8 +166,7 @@ public:
 // whether any is not 0.
 bool recentre(const double *xyz, size_t n, double shift[3]);
 
-std::unique_ptr<Triangulator> make_triangulator(int threads,
-                                                const double *bbox6);
+std::unique_ptr<Triangulator> make_triangulator();
 
 // Pruning and manifold extraction over the candidates (prune.cpp,
 // extract.cpp).

@@ -773,10 +773,6 @@ bool label_and_close(DT &dt, std::vector<uint32_t> &tris, Progress &progress,
 
 template bool label_and_close<DtSeq>(DtSeq &, std::vector<uint32_t> &,
                                      Progress &, sc_diag_t &);
-#ifdef CGAL_LINKED_WITH_TBB
-template bool label_and_close<DtPar>(DtPar &, std::vector<uint32_t> &,
-                                     Progress &, sc_diag_t &);
-#endif
 
 } // namespace dt
 } // namespace sc

@@ -153,10 +153,6 @@ void compute_poles(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
 
 template void compute_poles<DtSeq>(DtSeq &, std::vector<DtSeq::Cell_handle> &,
                                    Progress &, sc_diag_t &, const Ownership *);
-#ifdef CGAL_LINKED_WITH_TBB
-template void compute_poles<DtPar>(DtPar &, std::vector<DtPar::Cell_handle> &,
-                                   Progress &, sc_diag_t &, const Ownership *);
-#endif
 
 } // namespace dt
 } // namespace sc

@@ -36,19 +36,6 @@ constexpr size_t kMinBubble = 8;
 // shortcrust-noise-table and on the shared closed models).
 constexpr double kNoiseFloor = SC_NOISE_FLOOR;
 
-// The box of n points (min x, y, z, then max x, y, z).
-void bounding_box(const double *xyz, size_t n, double box[6]) {
-  for (int k = 0; k < 3; ++k) {
-    box[k] = std::numeric_limits<double>::infinity();
-    box[3 + k] = -std::numeric_limits<double>::infinity();
-  }
-  for (size_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      box[k] = std::min(box[k], xyz[3 * i + k]);
-      box[3 + k] = std::max(box[3 + k], xyz[3 * i + k]);
-    }
-}
-
 void check_finite(const double *xyz, size_t n, size_t first) {
   for (size_t i = 0; i < 3 * n; ++i) {
     if (!std::isfinite(xyz[i])) {
@@ -137,9 +124,7 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     // numbered as the surface's vertices are.
     std::unique_ptr<Triangulator> dt = std::move(kept_);
     if (!dt) {
-      double box[6];
-      bounding_box(lxyz, m, box);
-      dt = make_triangulator(params_.threads, box);
+      dt = make_triangulator();
       dt->insert(lxyz, 0, m, progress);
     }
     std::vector<uint32_t> labelled;
@@ -335,11 +320,8 @@ void Recon::insert_range(const double *xyz, size_t first, size_t n) {
   if (n == 0)
     return;
   Progress progress(params_.progress, params_.progress_user);
-  if (!dt_) {
-    double box[6];
-    bounding_box(xyz + 3 * first, n, box);
-    dt_ = make_triangulator(params_.threads, box);
-  }
+  if (!dt_)
+    dt_ = make_triangulator();
   Stopwatch sw;
   progress.stage(SC_STAGE_DELAUNAY);
   dt_->insert(xyz, first, n, progress);

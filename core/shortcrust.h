@@ -165,10 +165,10 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    are closed after extraction by a least-area triangulation of the loop;
  *    0 disables.
  *  - threads: threads of the reconstruction; 0 means one per core. With
- *    several tiles, the tiles run on them; with one, the points go into
- *    CGAL's parallel triangulation one after the other, which gains
- *    nothing (README, "Benchmark"). Denoising's smoothing runs on them too,
- *    with the same result on any number.
+ *    several tiles, the tiles run on them; one triangulation runs on one
+ *    thread (CGAL's parallel triangulation measured no faster: README,
+ *    "Benchmark"). Denoising's smoothing runs on them too, with the same
+ *    result on any number.
  *  - tiles (cocone and shortcrust modes; the others run one
  *    triangulation): the points are split into this many tiles whose
  *    triangulations are certified against each other, so that the mesh is
@@ -243,8 +243,8 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "close holes of at most N edges, 0 = never")                               \
   X(threads, int, INT, 1, 0, 1024, SC_RANGE_CLOSED, "in [0, 1024]", LOCAL,     \
     'j', "threads", "N",                                                       \
-    "threads for the tiles and the smoothing (one triangulation gains "        \
-    "nothing from them), 0 = one per core")                                    \
+    "threads for the tiles and the smoothing (a single triangulation "         \
+    "runs on one), 0 = one per core")                                          \
   X(tiles, int, INT, 1, 0, 4096, SC_RANGE_CLOSED, "in [0, 4096]", LOCAL, 0,    \
     "tiles", "N",                                                              \
     "split the points into N tiles triangulated apart, on the threads; the "   \

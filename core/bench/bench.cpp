@@ -220,10 +220,9 @@ void usage(FILE *f) {
       "prints, per size,\n"
       "its time and peak memory against CGAL's Delaunay construction of "
       "the same points\n"
-      "alone, the gain of the parallel triangulation, and CGAL's "
-      "advancing-front\n"
-      "reconstruction of the same points (time, and whether it is "
-      "closed).\n\n"
+      "alone, the gain of more threads (the smoothing's; with --tiles, "
+      "the tiles'),\nand CGAL's advancing-front reconstruction of the same "
+      "points (time, and\nwhether it is closed).\n\n"
       "  --sizes      point counts (default 100000,1000000)\n"
       "  --surface    sphere, ellipsoid, torus, genus2, two-spheres, "
       "nested-spheres\n"
@@ -414,11 +413,6 @@ int main(int argc, char **argv) {
       char name[64];
       std::snprintf(name, sizeof name, "shortcrust, %d threads", threads);
       print_row(name, par, n);
-      if (par.ok)
-        std::printf("    delaunay stage %.3f s (%.2fx of 1 thread)\n",
-                    par.stage[SC_STAGE_DELAUNAY],
-                    par.stage[SC_STAGE_DELAUNAY] /
-                        one.stage[SC_STAGE_DELAUNAY]);
     }
     // Tiles: on one thread (the overhead) and on all (the gain), against
     // the single triangulation on one thread and CGAL's construction.

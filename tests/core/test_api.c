@@ -240,7 +240,7 @@ int main(void) {
   EXPECT_EQ(sc_recon_new(&bad, &r), SC_EINVALID_ARGUMENT);
   EXPECT_NULL(r);
 
-  /* The parallel triangulation gives the same surface. */
+  /* More threads (the smoothing's, here none) give the same surface. */
   sc_params_t par = p;
   par.threads = 2;
   sc_mesh_t *pm = NULL;
