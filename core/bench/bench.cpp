@@ -10,6 +10,7 @@
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -215,7 +216,7 @@ void usage(FILE *f) {
       "[--denoise]\n"
       "                        [--threads N] [--tiles N] "
       "[--memory-limit F] [--no-peer]\n"
-      "                        [--peer-max N] [--seed S]\n\n"
+      "                        [--peer-max N] [--seed S] [--repeat N]\n\n"
       "Times the reconstruction stage by stage on generated samples and "
       "prints, per size,\n"
       "its time and peak memory against CGAL's Delaunay construction of "
@@ -251,7 +252,12 @@ void usage(FILE *f) {
       "--surface,\n"
       "               --density and --noise are then ignored)\n"
       "  --mode       shortcrust's mode (default cocone)\n"
-      "  --denoise    shortcrust denoises (docs/algorithm.md section 16)\n");
+      "  --denoise    shortcrust denoises (docs/algorithm.md section 16)\n"
+      "  --repeat     time CGAL's construction alone and the one-thread run "
+      "N times,\n"
+      "               in turn, and report the round of the median ratio "
+      "(default 1,\n"
+      "               at most 99)\n");
 }
 
 void print_row(const char *name, const Result &r, size_t n) {
@@ -285,6 +291,7 @@ int main(int argc, char **argv) {
   size_t peer_max = 1000000;
   uint64_t seed = 1;
   double noise = 0;
+  int repeat = 1;
   const char *input = nullptr;
   Job job;
   for (int i = 1; i < argc; ++i) {
@@ -345,6 +352,8 @@ int main(int argc, char **argv) {
           job.mode = k;
     } else if (a == "--denoise") {
       job.denoise = 1;
+    } else if (a == "--repeat") {
+      repeat = std::atoi(value());
     } else if (a == "-h" || a == "--help") {
       usage(stdout);
       return 0;
@@ -356,9 +365,9 @@ int main(int argc, char **argv) {
     }
   }
   if (surface < 0 || density < 0 || threads < 1 || job.mode < 0 ||
-      !(noise >= 0) || tiles < 1) {
+      !(noise >= 0) || tiles < 1 || repeat < 1 || repeat > 99) {
     std::fprintf(stderr, "shortcrust-bench: bad --surface, --density, "
-                         "--threads, --tiles, --mode or --noise\n");
+                         "--threads, --tiles, --mode, --noise or --repeat\n");
     return 2;
   }
   if (input)
@@ -397,9 +406,37 @@ int main(int argc, char **argv) {
     }
     std::printf("  shortcrust: mode %s%s\n", sc_mode_name(job.mode),
                 job.denoise ? ", --denoise" : "");
-    Result dt = run_cgal_delaunay(xyz.data(), n);
+    // CGAL's construction alone and the reconstruction on one thread,
+    // --repeat times, one after the other; the round whose ratio is the
+    // median stands for them (a busy machine slows single runs by up to
+    // half, and not both of a pair alike).
+    std::vector<std::pair<Result, Result>> rounds;
+    for (int k = 0; k < repeat; ++k) {
+      Result d = run_cgal_delaunay(xyz.data(), n);
+      Result o = run_shortcrust(xyz.data(), n, 1, job);
+      if (repeat > 1)
+        std::printf("  round %d: cgal delaunay alone %.3f s, shortcrust "
+                    "%.3f s, ratio %.2f\n",
+                    k + 1, d.seconds, o.seconds,
+                    d.ok && o.ok ? o.seconds / d.seconds : 0.0);
+      if (!d.ok || !o.ok) {
+        rounds.assign(1, {d, o});
+        break;
+      }
+      rounds.emplace_back(d, o);
+    }
+    std::sort(rounds.begin(), rounds.end(), [](const auto &a, const auto &b) {
+      return a.second.seconds / a.first.seconds <
+             b.second.seconds / b.first.seconds;
+    });
+    const Result dt = rounds[rounds.size() / 2].first;
+    const Result one = rounds[rounds.size() / 2].second;
+    if (rounds.size() > 1)
+      std::printf("  the median round of %zu (ratios %.2f to %.2f):\n",
+                  rounds.size(),
+                  rounds.front().second.seconds / rounds.front().first.seconds,
+                  rounds.back().second.seconds / rounds.back().first.seconds);
     print_row("cgal delaunay alone", dt, n);
-    Result one = run_shortcrust(xyz.data(), n, 1, job);
     print_row("shortcrust, 1 thread", one, n);
     if (one.ok) {
       std::printf("    stages:");
