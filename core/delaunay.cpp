@@ -173,6 +173,25 @@ public:
 
   void insert(const double *xyz, size_t first, size_t n,
               Progress &progress) override {
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), uint32_t(first));
+    insert_indices(xyz, std::move(order), first == 0, progress);
+  }
+
+  // Takes over dt, whose vertices carry input indices, then inserts the
+  // points of rest (input indices) into it: the tiles' fallback.
+  void adopt(DT &dt, const double *xyz, std::vector<uint32_t> rest,
+             Progress &progress) {
+    dt_.swap(dt);
+    if (!rest.empty())
+      insert_indices(xyz, std::move(rest), false, progress);
+  }
+
+  // Inserts the points of xyz whose indices are in order (any order);
+  // first: they are the first points, 0 .. order.size() - 1.
+  void insert_indices(const double *xyz, std::vector<uint32_t> order,
+                      bool first, Progress &progress) {
+    const size_t n = order.size();
     // A biased randomized insertion order (Amenta, Choi and Rote), the one
     // CGAL's spatial_sort() makes: rounds, each a quarter of the size of
     // the next, each in Hilbert order. It is drawn from one Hilbert sort of
@@ -182,8 +201,6 @@ public:
     // the order give progress and cancellation points, and each continues
     // where the last one ended, so insertion keeps the locality of a single
     // sorted insert.
-    std::vector<uint32_t> order(n);
-    std::iota(order.begin(), order.end(), uint32_t(first));
     hilbert_sort(xyz, order);
     std::vector<uint32_t> brio;
     // A chunk that comes after at least as many points lands in a
@@ -198,7 +215,7 @@ public:
     } else {
       brio = brio_order(order);
     }
-    if (first == 0)
+    if (first)
       hilbert_.swap(order);
     else
       hilbert_.clear();
@@ -381,6 +398,15 @@ private:
 };
 
 } // namespace
+
+std::unique_ptr<Triangulator> adopt_triangulation(DtSeq &dt, const double *xyz,
+                                                  std::vector<uint32_t> rest,
+                                                  Progress &progress) {
+  auto t = std::make_unique<TriangulatorImpl<DtSeq>>();
+  t->adopt(dt, xyz, std::move(rest), progress);
+  return t;
+}
+
 } // namespace dt
 
 // CGAL's concurrent triangulation was measured slower here than the

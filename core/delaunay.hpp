@@ -260,6 +260,13 @@ void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
                        std::vector<uint32_t> &tris, sc_diag_t &diag,
                        const Ownership *own = nullptr, Checks *check = nullptr);
 
+// A Triangulator (delaunay.cpp) that takes over dt, whose vertices carry
+// input indices (dt is left empty), with the points of rest (input indices)
+// inserted: all of them then, as if insert() had inserted them.
+std::unique_ptr<Triangulator> adopt_triangulation(DtSeq &dt, const double *xyz,
+                                                  std::vector<uint32_t> rest,
+                                                  Progress &progress);
+
 // Watertight mode's labelling of the cells (labels.cpp): see
 // Triangulator::close().
 template <class DT>

@@ -349,11 +349,14 @@ namespace dt {
 // counts, where the points cannot be split (too few) or span no volume:
 // the single triangulation then takes over. bounded: at most `threads`
 // triangulations at a time (within a memory limit), each tile
-// triangulated twice.
+// triangulated twice. Where tiles that may give up (tiles 0) do, it
+// returns false too, and with fallback the triangulation of all the points,
+// grown from the largest tile's (the time counts in seconds).
 bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                   bool bounded, double margin, const sc_params_t &params,
                   Progress &progress, Filtered &out, sc_diag_t &diag,
-                  double seconds[SC_STAGE_COUNT]);
+                  double seconds[SC_STAGE_COUNT],
+                  std::unique_ptr<Triangulator> *fallback = nullptr);
 
 // One tile of a job split over several reconstructions (section 17.6): of
 // the n points split into `tiles` tiles as tiled_filter() splits them, tile

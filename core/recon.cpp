@@ -546,13 +546,18 @@ sc_mesh_t *Recon::finish() {
     merged = merged && merge_[i]->diag.tiles >= 2;
   if (merged)
     dt::merge_tiles(work, n_, merge_, merge_count_, checks(params_), f, diag);
+  // Tiles that gave up hand over the triangulation they had begun.
+  std::unique_ptr<Triangulator> begun;
   const bool tiled =
-      merged || (!dt_ && tile_count() &&
-                 dt::tiled_filter(work, n_, tile_count(), thread_count(),
-                                  params_.memory_limit > 0, tile_margin(),
-                                  params_, progress, f, diag, seconds_));
+      merged ||
+      (!dt_ && tile_count() &&
+       dt::tiled_filter(work, n_, tile_count(), thread_count(),
+                        params_.memory_limit > 0, tile_margin(), params_,
+                        progress, f, diag, seconds_, &begun));
   if (!tiled) {
     f = Filtered();
+    if (!dt_)
+      dt_ = std::move(begun);
     if (!dt_)
       insert_range(work, 0, n_);
     check_spread(n_, dt_.get());

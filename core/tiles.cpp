@@ -366,7 +366,8 @@ struct Tile {
   // between its two passes.
   std::vector<uint32_t> vertices;
   sc_diag_t diag;
-  size_t foreign = 0; // points of other tiles inserted
+  bool numbered = false; // vertices carry vertex numbers, not input indices
+  size_t foreign = 0;    // points of other tiles inserted
   double work = 0;    // of certify(): leaves of the tree read, and sweeping
   Tile() { std::memset(&diag, 0, sizeof diag); }
 };
@@ -1203,13 +1204,48 @@ void tile_poles(Tile &t, const Ownership &own, Progress &progress,
                   sizeof v->info().pole);
 }
 
+// When the tiles give up: the triangulation of the tile with the most
+// vertices, with every other tile's points inserted, is the triangulation
+// of all the points (a function of the points, CGAL's perturbation
+// included), so the single triangulation starts from it instead of from
+// nothing. The other tiles are freed first.
+std::unique_ptr<Triangulator> take_over(const double *xyz,
+                                        std::vector<Tile> &ts,
+                                        const std::vector<uint32_t> &to_input,
+                                        Progress &progress) {
+  size_t best = 0;
+  for (size_t i = 1; i < ts.size(); ++i)
+    if (ts[i].dt.number_of_vertices() > ts[best].dt.number_of_vertices())
+      best = i;
+  std::vector<uint32_t> rest;
+  for (size_t i = 0; i < ts.size(); ++i)
+    if (i != best) {
+      rest.insert(rest.end(), ts[i].own.begin(), ts[i].own.end());
+      ts[i].dt.clear();
+      ts[i].own = {};
+      ts[i].member = {};
+      ts[i].infinite = {};
+    }
+  Tile &t = ts[best];
+  t.infinite = {};
+  t.member = {};
+  // Back to input indices, and nothing else of the tiles' work: the cells'
+  // marks are overwritten by the poles stage.
+  for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
+       ++v)
+    v->info() =
+        VertexData(t.numbered ? to_input[v->info().idx] : v->info().idx);
+  return adopt_triangulation(t.dt, xyz, std::move(rest), progress);
+}
+
 } // namespace
 
 // See internal.hpp.
 bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                   bool bounded, double margin, const sc_params_t &params,
                   Progress &progress, Filtered &out, sc_diag_t &diag,
-                  double seconds[SC_STAGE_COUNT]) {
+                  double seconds[SC_STAGE_COUNT],
+                  std::unique_ptr<Triangulator> *fallback) {
   Stopwatch sw;
   progress.stage(SC_STAGE_DELAUNAY);
   std::vector<Tile> ts = make_tiles(xyz, n, tiles, margin);
@@ -1258,6 +1294,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
       for (auto v = t.dt.finite_vertices_begin();
            v != t.dt.finite_vertices_end(); ++v)
         v->info() = VertexData(rank[v->info().idx]);
+      t.numbered = true;
     }
     if (grow_tile(shared, t, pts, owner, false, give_up, p))
       return true;
@@ -1325,6 +1362,9 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                    [&](size_t i, Progress &p) { (void)grow(ts[i], p); });
     } catch (const NotTileable &e) {
       diag.tile_points_foreign = e.foreign;
+      if (fallback)
+        *fallback = take_over(xyz, ts, out.to_input, progress);
+      seconds[SC_STAGE_DELAUNAY] += sw.lap();
       return false;
     }
     if (flat.load())
