@@ -288,9 +288,9 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
                 : "");
   else if (r->params.memory_limit > 0 || r->params.tiles != 1)
     fprintf(f, "Tiles: none, one triangulation: %s.\n",
-            r->params.mode != SC_MODE_COCONE &&
-                    r->params.mode != SC_MODE_SHORTCRUST
-                ? "this mode does not tile"
+            r->params.mode == SC_MODE_WATERTIGHT && r->params.watertight_labels
+                ? "watertight mode's labelling alone labels one "
+                  "triangulation"
             : r->params.memory_limit > 0 ? "it fits the memory limit"
             : r->params.tiles == 0 && r->params.threads == 1
                 ? "one tile per thread, and one thread"

@@ -41,13 +41,16 @@ void open_hull_cells(DT &dt,
   // rest of this stage on small input, and a vector of (vertex, normal)
   // pairs grown one by one was most of its memory).
   const std::vector<Ch> &outside = infinite;
-  std::vector<V3> hull(outside.size());
-  std::vector<uint32_t> head(dt.number_of_vertices(), UINT32_MAX),
-      next(3 * outside.size());
   auto corner = [&](uint32_t i) {
     Ch c = outside[i / 3];
     return c->vertex((c->index(dt.infinite_vertex()) + 1 + i % 3) % 4);
   };
+  // Vertex numbers: those of all the points in a tile (tiles.cpp).
+  uint32_t top = 0;
+  for (uint32_t i = 0; i < 3 * outside.size(); ++i)
+    top = std::max(top, corner(i)->info().idx + 1);
+  std::vector<V3> hull(outside.size());
+  std::vector<uint32_t> head(top, UINT32_MAX), next(3 * outside.size());
   for (uint32_t f = 0; f < outside.size(); ++f) {
     V3 pts[3];
     hull[f] = hull_normal(outside[f],
@@ -141,28 +144,51 @@ std::vector<uint16_t> measure_cells(DT &dt, double sin2_c, double cos_a,
   return cell_links;
 }
 
-// Marks the samples that pass the ratio test (kVRatio). Those whose poles
+// The ratio test (kVRatio): of the samples that pass it, those whose poles
 // agree with every cocone neighbour's are the seeds, interior (state 1);
-// the others that pass wait (state 2, and listed in waiting).
+// the others wait (state 2). With own, only the tile's own samples.
 template <class DT>
 void ratio_test(DT &dt, double rho, std::vector<uint8_t> &state,
-                std::vector<typename DT::Vertex_handle> &waiting) {
+                const Ownership *own) {
   const float rho2 = float(rho * rho);
   for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end();
        ++v) {
     VertexData &d = v->info();
+    if (own && !(*own)(d.idx))
+      continue;
     d.flags &= uint8_t(~(kVRatio | kVInterior));
     if ((d.h2 > 0 && d.r2 <= rho2 * d.h2) || d.r2 <= kNearRatio2 * d.nn2)
       d.flags |= kVRatio;
-    if (!(d.flags & kVRatio))
-      continue;
-    if (!(d.flags & kVDisagree)) {
-      d.flags |= kVInterior;
-      state[d.idx] = 1;
-    } else {
-      waiting.push_back(v);
-      state[d.idx] = 2;
-    }
+    if (d.flags & kVRatio)
+      state[d.idx] = (d.flags & kVDisagree) ? 2 : 1;
+  }
+}
+
+// Makes interior (state 1) the waiting samples (state 2) that links
+// (from, to) reach from the samples in grown, which are interior; frees
+// links.
+void follow_links(std::vector<std::pair<uint32_t, uint32_t>> &links,
+                  std::vector<uint32_t> &grown, std::vector<uint8_t> &state) {
+  const size_t m = state.size();
+  std::vector<uint32_t> first(m + 1, 0), to(links.size());
+  for (const auto &l : links)
+    ++first[l.first + 1];
+  for (size_t v = 0; v < m; ++v)
+    first[v + 1] += first[v];
+  {
+    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+    for (const auto &l : links)
+      to[fill[l.first]++] = l.second;
+  }
+  links = {};
+  while (!grown.empty()) {
+    const uint32_t v = grown.back();
+    grown.pop_back();
+    for (uint32_t i = first[v]; i < first[v + 1]; ++i)
+      if (state[to[i]] == 2) {
+        state[to[i]] = 1;
+        grown.push_back(to[i]);
+      }
   }
 }
 
@@ -178,7 +204,6 @@ void ratio_test(DT &dt, double rho, std::vector<uint8_t> &state,
 template <class DT>
 void grow_interior(DT &dt, std::vector<uint16_t> &cell_links,
                    std::vector<uint8_t> &state, Progress &progress) {
-  const size_t m = dt.number_of_vertices();
   // The links along which a waiting sample q can become interior: from a
   // neighbour v that passes the ratio test, through a cell whose
   // circumcentre is in v's cocone, when their poles agree. One pass over
@@ -219,27 +244,8 @@ void grow_interior(DT &dt, std::vector<uint16_t> &cell_links,
         }
     }
   });
-  std::vector<uint32_t> first(m + 1, 0), to(links.size());
-  for (const auto &l : links)
-    ++first[l.first + 1];
-  for (size_t v = 0; v < m; ++v)
-    first[v + 1] += first[v];
-  {
-    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
-    for (const auto &l : links)
-      to[fill[l.first]++] = l.second;
-  }
-  links = {};
   cell_links = {};
-  while (!grown.empty()) {
-    const uint32_t v = grown.back();
-    grown.pop_back();
-    for (uint32_t i = first[v]; i < first[v + 1]; ++i)
-      if (state[to[i]] == 2) {
-        state[to[i]] = 1;
-        grown.push_back(to[i]);
-      }
-  }
+  follow_links(links, grown, state);
 }
 
 } // namespace
@@ -266,59 +272,117 @@ template <class DT>
 void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
               const sc_params_t &params, Progress &progress,
               std::vector<uint8_t> &boundary, sc_diag_t &diag) {
-  typedef typename DT::Vertex_handle Vh;
+  std::vector<uint8_t> state(dt.number_of_vertices(), 0);
+  std::vector<uint16_t> cell_links =
+      classify_measure(dt, infinite, params, progress, state, nullptr);
+  grow_interior(dt, cell_links, state, progress);
+  classify_end(params, state, boundary, diag);
+  mark_interior(dt, state);
+}
+
+template <class DT>
+std::vector<uint16_t>
+classify_measure(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
+                 const sc_params_t &params, Progress &progress,
+                 std::vector<uint8_t> &state, const Ownership *own) {
   const double rho =
       params.boundary_rho > 0 ? params.boundary_rho : kDefaultRho;
   const double alpha =
       params.boundary_alpha > 0 ? params.boundary_alpha : kDefaultAlpha;
   const double sin2_c = Criteria(params).sin2_cocone;
   const double cos_a = std::cos(alpha);
-
   open_hull_cells(dt, infinite, params.cocone_theta);
   std::vector<uint16_t> cell_links =
       measure_cells(dt, sin2_c, cos_a, progress);
-  std::vector<Vh> waiting;
-  const size_t m = dt.number_of_vertices();
-  std::vector<uint8_t> state(m, 0); // by vertex number: 1 interior, 2 waiting
-  ratio_test(dt, rho, state, waiting);
-  grow_interior(dt, cell_links, state, progress);
-  for (Vh q : waiting)
-    if (state[q->info().idx] == 1)
-      q->info().flags |= kVInterior;
+  ratio_test(dt, rho, state, own);
+  return cell_links;
+}
 
-  // Auto and watertight mode: when most samples are not interior the
-  // sample is too sparse or too small to tell a boundary from
-  // undersampling (every sample of a tetrahedron is a boundary sample,
-  // and two thirds of a sparse genus-2 surface's), and boundary mode
-  // would keep little, or would open true handles that watertight mode
-  // then cuts; run the closed-surface algorithm instead (watertight mode
-  // still closes what it leaves open).
-  size_t interior = 0;
-  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end();
-       ++v)
-    interior += (v->info().flags & kVInterior) != 0;
+template <class DT>
+void classify_links(DT &dt, std::vector<uint16_t> &cell_links,
+                    const Ownership &own, const std::vector<uint8_t> &state,
+                    std::vector<std::pair<uint32_t, uint32_t>> &links) {
+  size_t k = 0;
+  for_cells(dt, false, [&](auto c) {
+    const uint16_t mask = cell_links[k++];
+    if (!mask)
+      return;
+    uint32_t idx[4], low = UINT32_MAX;
+    for (int j = 0; j < 4; ++j) {
+      idx[j] = c->vertex(j)->info().idx;
+      low = std::min(low, idx[j]);
+    }
+    if (!own(low))
+      return;
+    for (int j = 0; j < 4; ++j)
+      if (state[idx[j]] != 0)
+        for (int i = 0; i < 4; ++i)
+          if (((mask >> (4 * j + i)) & 1) && state[idx[i]] == 2)
+            links.emplace_back(idx[j], idx[i]);
+  });
+  cell_links = {};
+}
+
+void classify_join(const sc_params_t &params, std::vector<uint8_t> &state,
+                   std::vector<std::pair<uint32_t, uint32_t>> &links,
+                   std::vector<uint8_t> &boundary, sc_diag_t &diag) {
+  std::vector<uint32_t> grown;
+  for (const auto &l : links)
+    if (state[l.first] == 1 && state[l.second] == 2) {
+      state[l.second] = 1;
+      grown.push_back(l.second);
+    }
+  follow_links(links, grown, state);
+  classify_end(params, state, boundary, diag);
+}
+
+// Auto and watertight mode: when most samples are not interior the
+// sample is too sparse or too small to tell a boundary from undersampling
+// (every sample of a tetrahedron is a boundary sample, and two thirds of a
+// sparse genus-2 surface's), and boundary mode would keep little, or would
+// open true handles that watertight mode then cuts; run the closed-surface
+// algorithm instead (watertight mode still closes what it leaves open).
+void classify_end(const sc_params_t &params, std::vector<uint8_t> &state,
+                  std::vector<uint8_t> &boundary, sc_diag_t &diag) {
+  const size_t m = state.size();
+  const size_t interior = size_t(std::count(state.begin(), state.end(), 1));
   if ((params.mode == SC_MODE_AUTO || params.mode == SC_MODE_WATERTIGHT) &&
       2 * interior < m) {
-    for (auto v = dt.finite_vertices_begin();
-         v != dt.finite_vertices_end(); ++v)
-      v->info().flags |= kVInterior;
+    state.assign(m, 1);
     boundary.clear();
     return;
   }
   boundary.assign(m, 0);
+  for (size_t v = 0; v < m; ++v) {
+    if (state[v] == 1)
+      continue;
+    boundary[v] = state[v] == 2 ? kBoundarySample : kOpenSample;
+    ++diag.boundary_samples;
+  }
+}
+
+template <class DT>
+void mark_interior(DT &dt, const std::vector<uint8_t> &state) {
   for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end();
        ++v) {
     VertexData &d = v->info();
-    if (d.flags & kVInterior)
-      continue;
-    boundary[d.idx] = (d.flags & kVRatio) ? kBoundarySample : kOpenSample;
-    ++diag.boundary_samples;
+    d.flags = uint8_t(state[d.idx] == 1 ? d.flags | kVInterior
+                                        : d.flags & ~kVInterior);
   }
 }
 
 template void classify<DtSeq>(DtSeq &, const std::vector<DtSeq::Cell_handle> &,
                               const sc_params_t &, Progress &,
                               std::vector<uint8_t> &, sc_diag_t &);
+template std::vector<uint16_t>
+classify_measure<DtSeq>(DtSeq &, const std::vector<DtSeq::Cell_handle> &,
+                        const sc_params_t &, Progress &, std::vector<uint8_t> &,
+                        const Ownership *);
+template void
+classify_links<DtSeq>(DtSeq &, std::vector<uint16_t> &, const Ownership &,
+                      const std::vector<uint8_t> &,
+                      std::vector<std::pair<uint32_t, uint32_t>> &);
+template void mark_interior<DtSeq>(DtSeq &, const std::vector<uint8_t> &);
 
 } // namespace dt
 } // namespace sc

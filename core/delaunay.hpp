@@ -249,6 +249,36 @@ void classify(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
               const sc_params_t &params, Progress &progress,
               std::vector<uint8_t> &boundary, sc_diag_t &diag);
 
+// The same over tiles (tiles.cpp), in its steps. A sample's state, by
+// vertex number: 0 when it fails the ratio test, 1 interior, 2 waiting (a
+// boundary sample unless the growth reaches it).
+//  - classify_measure(), in each tile once the poles of all its vertices
+//    are set: the states of the samples own allows (all without it); it
+//    returns the links of every cell, for classify_links();
+//  - classify_links(), in each tile once every state is in: the links of
+//    the cells the tile owns (by their lowest-numbered vertex) that the
+//    growth may follow, (from, to) by vertex number; frees cell_links;
+//  - classify_join(), once: the growth over all the links, then
+//    classify_end(), which fills boundary and diag (and makes every sample
+//    interior where too few are);
+//  - mark_interior(), in each tile: kVInterior from the states.
+template <class DT>
+std::vector<uint16_t>
+classify_measure(DT &dt, const std::vector<typename DT::Cell_handle> &infinite,
+                 const sc_params_t &params, Progress &progress,
+                 std::vector<uint8_t> &state, const Ownership *own);
+template <class DT>
+void classify_links(DT &dt, std::vector<uint16_t> &cell_links,
+                    const Ownership &own, const std::vector<uint8_t> &state,
+                    std::vector<std::pair<uint32_t, uint32_t>> &links);
+void classify_join(const sc_params_t &params, std::vector<uint8_t> &state,
+                   std::vector<std::pair<uint32_t, uint32_t>> &links,
+                   std::vector<uint8_t> &boundary, sc_diag_t &diag);
+void classify_end(const sc_params_t &params, std::vector<uint8_t> &state,
+                  std::vector<uint8_t> &boundary, sc_diag_t &diag);
+template <class DT>
+void mark_interior(DT &dt, const std::vector<uint8_t> &state);
+
 // The candidate triangles (candidates.cpp), by vertex number, from the one
 // pass over the Delaunay facets; frees infinite.
 // With own, only the facets the tile owns are tested and counted. With

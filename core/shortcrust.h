@@ -169,7 +169,7 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    thread (CGAL's parallel triangulation measured no faster: README,
  *    "Benchmark"). Denoising's smoothing runs on them too, with the same
  *    result on any number.
- *  - tiles (cocone and shortcrust modes; the others run one
+ *  - tiles (every mode; watertight mode with watertight_labels runs one
  *    triangulation): the points are split into this many tiles whose
  *    triangulations are certified against each other, so that the mesh is
  *    the one a single triangulation gives, triangle for triangle
@@ -248,8 +248,8 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
   X(tiles, int, INT, 1, 0, 4096, SC_RANGE_CLOSED, "in [0, 4096]", LOCAL, 0,    \
     "tiles", "N",                                                              \
     "split the points into N tiles triangulated apart, on the threads; the "   \
-    "same mesh whatever N; 0 = one per thread, while tiles pay (cocone and "   \
-    "shortcrust modes)")                                                       \
+    "same mesh whatever N; 0 = one per thread, while tiles pay (not with "     \
+    "--labels)")                                                               \
   X(memory_limit, double, BYTES, 0, 0, 1e300,                                  \
     SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "positive", LOCAL, 0,            \
     "memory-limit", "BYTES",                                                   \

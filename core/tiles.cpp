@@ -1313,13 +1313,18 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
   };
   // Phase 4: the candidates, each tile testing the facets it owns with the
   // poles of all.
-  auto candidates = [&](Tile &t, Progress &p) {
+  // The poles of the other tiles' vertices, from the shared array.
+  auto take_poles = [&](Tile &t) {
     const Ownership own{owner.data(), t.id};
     for (auto v = t.dt.finite_vertices_begin(); v != t.dt.finite_vertices_end();
          ++v)
       if (!own(v->info().idx))
         std::memcpy(v->info().pole, &out.poles[3 * size_t(v->info().idx)],
                     sizeof v->info().pole);
+  };
+  auto candidates = [&](Tile &t, Progress &p) {
+    const Ownership own{owner.data(), t.id};
+    take_poles(t);
     select_candidates(t.dt, t.infinite, params, p, t.tris, t.diag, &own,
                       checks(params) ? &t.check : nullptr);
     drop(t);
@@ -1373,6 +1378,34 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
     progress.stage(SC_STAGE_POLES);
     run_parallel(k, threads, progress,
                  [&](size_t i, Progress &p) { poles(ts[i], p, ts[i].diag); });
+    if (detects_boundary(params.mode)) {
+      // Boundary detection (section 5) over the tiles: each measures the
+      // cells around its own samples with the poles of all, the growth
+      // follows the links of every tile's cells once, and each tile's
+      // vertices then learn whether they are interior.
+      std::vector<uint8_t> state(m, 0);
+      std::vector<std::vector<uint16_t>> cell_links(k);
+      run_parallel(k, threads, progress, [&](size_t i, Progress &p) {
+        take_poles(ts[i]);
+        const Ownership own{owner.data(), ts[i].id};
+        cell_links[i] =
+            classify_measure(ts[i].dt, ts[i].infinite, params, p, state, &own);
+      });
+      std::vector<std::vector<std::pair<uint32_t, uint32_t>>> links(k);
+      run_parallel(k, threads, progress, [&](size_t i, Progress &) {
+        classify_links(ts[i].dt, cell_links[i], {owner.data(), ts[i].id}, state,
+                       links[i]);
+      });
+      std::vector<std::pair<uint32_t, uint32_t>> all;
+      for (auto &l : links) {
+        all.insert(all.end(), l.begin(), l.end());
+        l = {};
+      }
+      classify_join(params, state, all, out.boundary, diag);
+      run_parallel(k, threads, progress, [&](size_t i, Progress &) {
+        mark_interior(ts[i].dt, state);
+      });
+    }
     seconds[SC_STAGE_POLES] += sw.lap();
     progress.stage(SC_STAGE_CANDIDATES);
     run_parallel(k, threads, progress,

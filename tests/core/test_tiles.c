@@ -155,19 +155,35 @@ static void merged_same(const char *tag, const double *xyz, size_t n,
   sc_mesh_free(m);
 }
 
-static void check(const char *what, const double *xyz, size_t n) {
-  const sc_mode_t modes[] = {SC_MODE_COCONE, SC_MODE_SHORTCRUST};
-  const int tiles[][2] = {{2, 1}, {3, 2}, {5, 1}, {16, 2}};
-  for (size_t m = 0; m < 2; ++m) {
+/* Every mode, in tiles: the boundary modes' detection runs over the tiles
+ * too (docs/algorithm.md section 17.1), and tile jobs are for the cocone
+ * and shortcrust modes only. */
+static void check(const char *what, const double *xyz, size_t n,
+                  int all_modes) {
+  const sc_mode_t modes[] = {SC_MODE_COCONE, SC_MODE_SHORTCRUST,
+                             SC_MODE_BOUNDARY, SC_MODE_WATERTIGHT,
+                             SC_MODE_AUTO};
+  const int tiles[][2] = {{3, 2}, {16, 2}, {2, 1}, {5, 1}};
+  for (size_t m = 0; m < (all_modes ? 5u : 2u); ++m) {
+    const int boundary = m >= 2;
     sc_mesh_t *one = run(what, xyz, n, modes[m], 1, 1);
     if (!one)
       continue;
     EXPECT_GT(one->triangle_count, 0);
-    for (size_t k = 0; k < sizeof tiles / sizeof tiles[0]; ++k) {
+    for (size_t k = 0; k < (boundary ? 2 : 4); ++k) {
       sc_mesh_t *t = run(what, xyz, n, modes[m], tiles[k][0], tiles[k][1]);
-      if (t)
-        same(what, one, t, tiles[k][0], tiles[k][1]);
+      if (t) {
+        char tag[160];
+        snprintf(tag, sizeof tag, "%s, %s", what, sc_mode_name(modes[m]));
+        same(tag, one, t, tiles[k][0], tiles[k][1]);
+        EXPECT_EQ(one->diag.boundary_samples, t->diag.boundary_samples);
+        EXPECT_EQ(one->diag.boundary_loops, t->diag.boundary_loops);
+      }
       sc_mesh_free(t);
+    }
+    if (boundary) {
+      sc_mesh_free(one);
+      continue;
     }
     const int apart[] = {2, 5};
     for (size_t k = 0; k < 2; ++k) {
@@ -207,6 +223,13 @@ int main(int argc, char **argv) {
       same("torus", one, t, 2, 2);
     sc_mesh_free(one);
     sc_mesh_free(t);
+    /* Boundary detection over the tiles, on two threads. */
+    one = run("torus", xyz, n + dups, SC_MODE_BOUNDARY, 1, 1);
+    t = run("torus", xyz, n + dups, SC_MODE_BOUNDARY, 2, 2);
+    if (one && t)
+      same("torus, boundary", one, t, 2, 2);
+    sc_mesh_free(one);
+    sc_mesh_free(t);
     /* Smoothed on two threads (section 16), then in two tiles: the mesh
      * of one thread and one triangulation. */
     sc_params_t p;
@@ -227,7 +250,27 @@ int main(int argc, char **argv) {
     sc_mesh_free(t);
     goto cancel;
   }
-  check("torus", xyz, n + dups);
+  check("torus", xyz, n + dups, 0);
+
+  /* Half of a torus of twice the points: an open surface, with two
+   * boundary loops. */
+  {
+    double *open = malloc(6 * n * sizeof *open);
+    EXPECT_NOT_NULL(open);
+    EXPECT_EQ(
+        scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, 2 * n, 7, open),
+        0);
+    size_t half = 0;
+    for (size_t i = 0; i < 2 * n; ++i)
+      if (open[3 * i] < 0)
+        memmove(&open[3 * half++], &open[3 * i], 3 * sizeof *open);
+    sc_mesh_t *b = run("half torus", open, half, SC_MODE_BOUNDARY, 1, 1);
+    if (b)
+      EXPECT_EQ(b->diag.boundary_loops, 2);
+    sc_mesh_free(b);
+    check("half torus", open, half, 1);
+    free(open);
+  }
 
   /* Very uneven density: a genus-2 sample, one end 40 times as dense. */
   EXPECT_EQ(
@@ -236,7 +279,7 @@ int main(int argc, char **argv) {
   for (size_t i = 0; i < n; ++i)
     if (xyz[3 * i] < 0.5 || i % 40 == 0)
       memmove(&xyz[3 * kept++], &xyz[3 * i], 3 * sizeof *xyz);
-  check("uneven genus-2", xyz, kept);
+  check("uneven genus-2", xyz, kept, 0);
 
   /* A grid: the surface of a box of 61 x 41 x 21 points on every face. */
   kept = 0;
@@ -249,7 +292,7 @@ int main(int argc, char **argv) {
           xyz[3 * kept + 2] = k * 0.125;
           ++kept;
         }
-  check("grid box", xyz, kept);
+  check("grid box", xyz, kept, 1);
 
   /* Real scans, as given. */
   for (int a = 1; a < argc; ++a) {
@@ -259,7 +302,7 @@ int main(int argc, char **argv) {
       EXPECT_FAIL("%s: %s", argv[a], msg);
       continue;
     }
-    check(argv[a], pts.xyz, pts.count);
+    check(argv[a], pts.xyz, pts.count, 1);
     scf_points_free(&pts);
   }
 
@@ -449,9 +492,15 @@ cancel : {
     sc_mesh_free(parts[1]);
   }
 
-  /* The boundary modes run one triangulation whatever the tiles. */
+  /* Watertight mode's labelling alone (--labels) labels the cells of one
+   * triangulation, whatever the tiles. */
   {
-    sc_mesh_t *b = run("torus", xyz, n, SC_MODE_BOUNDARY, 4, 1);
+    sc_params_t p;
+    sc_params_init(&p);
+    p.mode = SC_MODE_WATERTIGHT;
+    p.watertight_labels = 1;
+    p.tiles = 4;
+    sc_mesh_t *b = run_with("torus", xyz, n, &p);
     if (b) {
       EXPECT_EQ(b->diag.tiles, 0);
       sc_mesh_free(b);

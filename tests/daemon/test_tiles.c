@@ -1,8 +1,8 @@
 /*
- * A daemon started with --tile-points runs a large cocone or shortcrust job
- * in tiles on the cores of its idle workers (docs/algorithm.md section 17):
- * the same triangles as the core on one thread; jobs below the size, of
- * another mode, or that did not announce their size run as before; two
+ * A daemon started with --tile-points runs a large job in tiles on the
+ * cores of its idle workers (docs/algorithm.md section 17): the same
+ * triangles as the core on one thread, in boundary mode too; jobs below
+ * the size, or that did not announce their size run as before; two
  * large jobs at once both finish, and every lent core comes back
  * (workers_lent, jobs_tiled_total in STATS).
  *
@@ -82,16 +82,20 @@ int main(int argc, char **argv) {
   EXPECT_EQ(tiled(), 1);
   scdt_job_reset(&a);
 
-  /* Not announced, or a mode that does not tile: as before. */
+  /* Not announced: as before. */
   a.declare = 0;
   run(c, one, 1);
   expect_same(&a, cocone, "a job of unannounced size");
+  EXPECT_EQ(tiled(), 1);
   scdt_job_reset(&a);
+  /* Boundary mode: its detection runs over the tiles too. */
   a.declare = 1;
   a.mode = SCP_MODE_BOUNDARY;
   run(c, one, 1);
-  EXPECT_MSG(a.done, "boundary mode: %s", a.error_msg);
-  EXPECT_EQ(tiled(), 1);
+  sc_mesh_t *open = direct(SC_MODE_BOUNDARY);
+  expect_same(&a, open, "a large boundary-mode job");
+  sc_mesh_free(open);
+  EXPECT_EQ(tiled(), 2);
   scdt_job_reset(&a);
 
   /* Two large jobs at once, one of them in the shortcrust mode: both
@@ -105,10 +109,10 @@ int main(int argc, char **argv) {
   expect_same(&a, cocone, "two large jobs at once, the first");
   expect_same(&b, crust, "two large jobs at once, the second");
   const uint64_t after = tiled();
-  EXPECT_MSG(after <= 3, "jobs_tiled_total %llu, want 1 to 3",
+  EXPECT_MSG(after <= 4, "jobs_tiled_total %llu, want 2 to 4",
              (unsigned long long)after);
   EXPECT_EQ(scdt_stat_fresh(d.sock, "workers_lent"), 0);
-  printf("tiles on idle workers: %llu of 4 large jobs tiled\n",
+  printf("tiles on idle workers: %llu of 5 large jobs tiled\n",
          (unsigned long long)after);
   scdt_job_reset(&a);
   scdt_job_reset(&b);
