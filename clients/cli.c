@@ -288,7 +288,7 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
                 : "");
   else if (r->params.memory_limit > 0 || r->params.tiles != 1)
     fprintf(f, "Tiles: none, one triangulation: %s.\n",
-            r->params.mode == SC_MODE_WATERTIGHT && r->params.watertight_labels
+            !sc_params_can_tile(&r->params)
                 ? "watertight mode's labelling alone labels one "
                   "triangulation"
             : r->params.memory_limit > 0 ? "it fits the memory limit"

@@ -73,6 +73,10 @@ extern "C" void sc_params_init(sc_params_t *p) {
     *p = sc::kDefaultParams;
 }
 
+extern "C" int sc_params_can_tile(const sc_params_t *p) {
+  return p && sc::can_tile(*p);
+}
+
 extern "C" int sc_params_check(const sc_params_t *p, char *msg,
                                size_t msg_len) {
   if (!p) {

@@ -45,7 +45,8 @@ void open_hull_cells(DT &dt,
     Ch c = outside[i / 3];
     return c->vertex((c->index(dt.infinite_vertex()) + 1 + i % 3) % 4);
   };
-  // Vertex numbers: those of all the points in a tile (tiles.cpp).
+  // In a tile (tiles.cpp) the vertices carry the numbers of all the
+  // points, beyond the tile's own count of vertices.
   uint32_t top = 0;
   for (uint32_t i = 0; i < 3 * outside.size(); ++i)
     top = std::max(top, corner(i)->info().idx + 1);

@@ -130,6 +130,14 @@ inline bool detects_boundary(int mode) {
          mode == SC_MODE_AUTO;
 }
 
+// See sc_params_can_tile(). Boundary detection runs over tiles, but not
+// within a memory limit (the tiles there never all hold their
+// triangulations at once).
+inline bool can_tile(const sc_params_t &p) {
+  return !(p.mode == SC_MODE_WATERTIGHT && p.watertight_labels) &&
+         !(detects_boundary(p.mode) && p.memory_limit > 0);
+}
+
 // The Delaunay-dependent stages, behind an interface that keeps CGAL's
 // types out of the rest of the pipeline.
 class Triangulator {

@@ -260,12 +260,8 @@ bool Recon::defer_insertion() const {
 // Within a memory limit the number of points decides (memory_tiles()), at
 // least as many as asked for.
 size_t Recon::tile_count() const {
-  // Boundary detection runs over tiles, but not within a memory limit (the
-  // tiles there never all hold their triangulations at once) nor in tile
-  // jobs; watertight mode's labelling alone labels the cells of one
-  // triangulation.
-  if (apart() || (detects_boundary(params_.mode) &&
-                  (params_.memory_limit > 0 || params_.watertight_labels)))
+  // A tile job is one tile already.
+  if (apart() || !can_tile(params_))
     return 0;
   size_t k = params_.tiles == 1  ? 0
              : params_.tiles > 0 ? size_t(params_.tiles)

@@ -344,6 +344,12 @@ void sc_params_init(sc_params_t *p);
  * sc_reconstruct() does: SC_OK, or SC_EINVALID_ARGUMENT with the reason
  * in msg (when msg is not NULL). */
 int sc_params_check(const sc_params_t *p, char *msg, size_t msg_len);
+/* Whether a job with these parameters can run in tiles on one machine
+ * (tiles other than 1, a memory limit, the daemon's --tile-points): 1 in
+ * every mode but watertight mode's labelling alone (watertight_labels),
+ * which labels the cells of one triangulation, and the boundary modes
+ * within a memory limit (which sc_params_check() refuses). */
+int sc_params_can_tile(const sc_params_t *p);
 
 /* Boundary loops are counted by length in edges, in these bins:
  * X(index, wire suffix, least, most); most 0 for no upper bound. */

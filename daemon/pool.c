@@ -164,9 +164,7 @@ static int outbox_post(scd_pool_t *p, scd_task_t *t, unsigned ev) {
  * for all of its points (tiles split them all at once). */
 static int tiles_on_idle(const scd_pool_t *p, const scd_task_t *t) {
   return p->tile_points && t->declared >= p->tile_points &&
-         !(t->params.mode == SC_MODE_WATERTIGHT &&
-           t->params.watertight_labels) &&
-         t->params.tile_count == 0;
+         sc_params_can_tile(&t->params) && t->params.tile_count == 0;
 }
 
 static int runnable(const scd_pool_t *p, scd_task_t *t) {

@@ -127,6 +127,25 @@ int main(void) {
     EXPECT_EQ(sc_params_check(NULL, why, sizeof why), SC_EINVALID_ARGUMENT);
   }
 
+  /* Every mode tiles but watertight mode's labelling alone. */
+  {
+    sc_params_t q;
+    sc_params_init(&q);
+    EXPECT_EQ(sc_params_can_tile(&q), 1);
+    q.mode = SC_MODE_BOUNDARY;
+    q.watertight_labels = 1; /* a watertight option: boundary mode tiles */
+    EXPECT_EQ(sc_params_can_tile(&q), 1);
+    q.mode = SC_MODE_WATERTIGHT;
+    EXPECT_EQ(sc_params_can_tile(&q), 0);
+    q.watertight_labels = 0;
+    EXPECT_EQ(sc_params_can_tile(&q), 1);
+    q.memory_limit = 1e9;
+    EXPECT_EQ(sc_params_can_tile(&q), 0);
+    q.mode = SC_MODE_COCONE;
+    EXPECT_EQ(sc_params_can_tile(&q), 1);
+    EXPECT_EQ(sc_params_can_tile(NULL), 0);
+  }
+
   double *xyz = malloc(3 * N * sizeof *xyz);
   scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, N, 11, xyz);
   sc_params_t p;
