@@ -146,6 +146,16 @@ void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
                        const Ownership *own, Checks *check) {
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
+  // Room for the candidates (a closed surface has two triangles per
+  // sample, the candidates a few more), and the part of it surely filled
+  // resident at once (prefault.hpp; a tile's triangulation holds its
+  // neighbours' points too, an open scan fewer triangles): growing the
+  // list by doubling touched every page twice, a fault each.
+  const size_t have = tris.size(), nv = dt.number_of_vertices();
+  if (tris.capacity() < have + 15 * nv / 2) {
+    tris.reserve(have + 15 * nv / 2);
+    prefault(tris.data() + have, 9 * nv / 2 * sizeof(uint32_t));
+  }
   Criteria cr(params);
   // The check's test: the cocone's (at every vertex: shortcrust mode
   // detects no boundary).

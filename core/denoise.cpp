@@ -6,6 +6,7 @@
 
 #include "internal.hpp"
 #include "parallel.hpp"
+#include "prefault.hpp"
 
 #include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Search_traits_3.h>
@@ -124,7 +125,7 @@ public:
       buckets <<= 1;
     mask_ = buckets - 1;
     start_.assign(buckets + 1, 0);
-    std::vector<uint32_t> bucket(n);
+    PrefaultVector<uint32_t> bucket(n);
     for (size_t i = 0; i < n; ++i) {
       int64_t c[3];
       cell(&xyz[3 * i], c);
@@ -137,7 +138,7 @@ public:
       start_[b + 1] += start_[b];
     }
     order_.resize(n);
-    std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
+    PrefaultVector<uint32_t> fill(start_.begin(), start_.end() - 1);
     for (size_t i = 0; i < n; ++i)
       order_[fill[bucket[i]]++] = uint32_t(i);
     if (most > kCrowded) {
@@ -239,7 +240,7 @@ private:
   double lo_[3], side_;
   size_t mask_;
   std::unique_ptr<KdTree> tree_;
-  std::vector<uint32_t> start_, order_;
+  PrefaultVector<uint32_t> start_, order_;
   mutable std::vector<std::pair<double, uint32_t>> best_;
 };
 
@@ -543,7 +544,7 @@ public:
     }
     order_.resize(n);
     keys_.resize(n);
-    std::vector<std::pair<uint64_t, uint32_t>> kv(n);
+    PrefaultVector<std::pair<uint64_t, uint32_t>> kv(n);
     for (size_t i = 0; i < n; ++i)
       kv[i] = {key_of(&xyz[3 * i]), uint32_t(i)};
     std::sort(kv.begin(), kv.end());
@@ -551,6 +552,7 @@ public:
       keys_[i] = kv[i].first;
       order_[i] = kv[i].second;
     }
+    index_cells();
   }
   uint64_t key_of(const double *p) const {
     uint64_t key = 0;
@@ -559,19 +561,71 @@ public:
     return key;
   }
   // The points sorted by cell, and their keys.
-  const std::vector<uint32_t> &order() const { return order_; }
-  const std::vector<uint64_t> &keys() const { return keys_; }
-  // The range [first, last) of order() in the cell of key.
-  void cell(uint64_t key, size_t *first, size_t *last) const {
-    auto r = std::equal_range(keys_.begin(), keys_.end(), key);
-    *first = size_t(r.first - keys_.begin());
-    *last = size_t(r.second - keys_.begin());
+  PrefaultVector<uint32_t> &order() { return order_; }
+  const PrefaultVector<uint64_t> &keys() const { return keys_; }
+  // The range [first, last) of order() in the cells of keys lo to hi
+  // (consecutive keys: a run of cells along z), empty when they are.
+  void cells(uint64_t lo, uint64_t hi, size_t *first, size_t *last) const {
+    *first = *last = 0;
+    for (uint64_t key = lo; key <= hi; ++key) {
+      const Slot *s = find(key);
+      if (!s)
+        continue;
+      if (*first == *last)
+        *first = s->first;
+      *last = s->last;
+    }
   }
 
 private:
+  // The cells that hold points, in an open-addressing hash table: a
+  // neighbourhood's 21 runs of cells are a hundred lookups in a table
+  // the size of the cells, where binary searches over the keys of all the
+  // points took 40 steps through a much larger array.
+  struct Slot {
+    uint64_t key; // kEmpty: none
+    uint32_t first, last;
+  };
+  static constexpr uint64_t kEmpty = ~uint64_t(0); // keys use 63 bits
+  static size_t hash(uint64_t key) {
+    key *= 0x9E3779B97F4A7C15ull;
+    return size_t(key ^ (key >> 32));
+  }
+  void index_cells() {
+    size_t cells = 0;
+    for (size_t i = 0; i < keys_.size(); ++i)
+      cells += i == 0 || keys_[i] != keys_[i - 1];
+    size_t size = 2;
+    while (size < 2 * cells)
+      size <<= 1;
+    mask_ = size - 1;
+    slots_.assign(size, Slot{kEmpty, 0, 0});
+    for (size_t i = 0; i < keys_.size();) {
+      size_t j = i + 1;
+      while (j < keys_.size() && keys_[j] == keys_[i])
+        ++j;
+      size_t h = hash(keys_[i]) & mask_;
+      while (slots_[h].key != kEmpty)
+        h = (h + 1) & mask_;
+      slots_[h] = Slot{keys_[i], uint32_t(i), uint32_t(j)};
+      i = j;
+    }
+  }
+  const Slot *find(uint64_t key) const {
+    for (size_t h = hash(key) & mask_;; h = (h + 1) & mask_) {
+      const Slot &s = slots_[h];
+      if (s.key == key)
+        return &s;
+      if (s.key == kEmpty)
+        return nullptr;
+    }
+  }
+
   double side_, lo_[3];
-  std::vector<uint32_t> order_;
-  std::vector<uint64_t> keys_;
+  PrefaultVector<uint32_t> order_;
+  PrefaultVector<uint64_t> keys_;
+  PrefaultVector<Slot> slots_;
+  size_t mask_ = 0;
 };
 
 // Points per block of smoothing's loops, which run on the job's threads.
@@ -601,8 +655,8 @@ void for_blocks(size_t n, unsigned threads, Progress &progress, double from,
 // positions in the grid's order (point q's are the first count[q] of the
 // kMaxNeighbours slots at of(q)), and the points in that order.
 struct Neighbourhoods {
-  std::vector<uint32_t> order; // position -> input index
-  std::vector<uint8_t> count;
+  PrefaultVector<uint32_t> order; // position -> input index
+  PrefaultVector<uint8_t> count;
   std::unique_ptr<uint32_t[]> list;
   const uint32_t *of(size_t q) const { return &list[q * kMaxNeighbours]; }
 };
@@ -614,9 +668,9 @@ void find_neighbours(const double *xyz, size_t n, double r, unsigned threads,
   // corners, whose nearest point is farther than r. Each column of five
   // cells along z is a run of consecutive keys.
   Grid grid(xyz, n, r / 2);
-  const std::vector<uint64_t> &keys = grid.keys();
-  nb.order = grid.order();
-  std::vector<double> xs(n), ys(n), zs(n);
+  const PrefaultVector<uint64_t> &keys = grid.keys();
+  nb.order.swap(grid.order());
+  PrefaultVector<double> xs(n), ys(n), zs(n);
   for (size_t q = 0; q < n; ++q) {
     const double *c = &xyz[3 * size_t(nb.order[q])];
     xs[q] = c[0], ys[q] = c[1], zs[q] = c[2];
@@ -625,6 +679,7 @@ void find_neighbours(const double *xyz, size_t n, double r, unsigned threads,
   constexpr uint64_t kAxis = (uint64_t(1) << 21) - 1;
   nb.count.assign(n, 0);
   nb.list.reset(new uint32_t[n * kMaxNeighbours]);
+  prefault(nb.list.get(), n * kMaxNeighbours * sizeof(uint32_t));
   // A block starts its first cell where the block starts: a point's
   // neighbours depend on its cell only.
   for_blocks(n, threads, progress, 0, 0.4, [&](size_t begin, size_t end) {
@@ -644,13 +699,7 @@ void find_neighbours(const double *xyz, size_t n, double r, unsigned threads,
           const uint64_t k0 = (uint64_t(int64_t(cx) + dx) << 42) |
                               (uint64_t(int64_t(cy) + dy) << 21) |
                               ((key & kAxis) - 2);
-          // Columns after this cell's start after the points of it.
-          const bool after = dx > 0 || (dx == 0 && dy > 0);
-          const auto lo = std::lower_bound(
-              keys.begin() + (after ? long(first) : 0), keys.end(), k0);
-          const auto hi = std::upper_bound(lo, keys.end(), k0 + 4);
-          ranges[nr][0] = size_t(lo - keys.begin());
-          ranges[nr][1] = size_t(hi - keys.begin());
+          grid.cells(k0, k0 + 4, &ranges[nr][0], &ranges[nr][1]);
           if (ranges[nr][0] < ranges[nr][1])
             ++nr;
         }
@@ -704,9 +753,9 @@ inline double weight(double d2, double inv) {
 }
 
 // Each point's unit normal: that of its neighbours' weighted plane.
-void plane_normals(const Neighbourhoods &nb, const std::vector<double> &cur,
+void plane_normals(const Neighbourhoods &nb, const PrefaultVector<double> &cur,
                    size_t begin, size_t end, double r,
-                   std::vector<double> &normals) {
+                   PrefaultVector<double> &normals) {
   const double inv = 1.0 / (r * r);
   for (size_t q = begin; q < end; ++q) {
     const double *p = &cur[3 * q];
@@ -728,9 +777,10 @@ void plane_normals(const Neighbourhoods &nb, const std::vector<double> &cur,
 // the frame of that normal, into next; the normal becomes the quadric's at
 // the new point. The plane alone would pull the points of a curved surface
 // inward (section 16.3).
-void project_step(const Neighbourhoods &nb, const std::vector<double> &cur,
+void project_step(const Neighbourhoods &nb, const PrefaultVector<double> &cur,
                   size_t begin, size_t end, double r,
-                  std::vector<double> &normals, std::vector<double> &next) {
+                  PrefaultVector<double> &normals,
+                  PrefaultVector<double> &next) {
   const double inv = 1.0 / (r * r), hs = 1.0 / r;
   for (size_t q = begin; q < end; ++q) {
     const double *p = &cur[3 * q];
@@ -777,6 +827,8 @@ Smoothing smooth(const double *xyz, size_t n, double scale,
                  std::vector<double> &out) {
   Smoothing done;
   done.scale = scale;
+  out.reserve(3 * n);
+  prefault(out.data(), 3 * n * sizeof(double));
   out.assign(xyz, xyz + 3 * n);
   if (n < kMinPoints || !(e.spacing > 0) || !(scale > 0))
     return done;
@@ -784,7 +836,7 @@ Smoothing smooth(const double *xyz, size_t n, double scale,
   find_neighbours(xyz, n, scale, threads, progress, nb);
   // The points in the grid's order, smoothed there, then put back. Each
   // step reads cur and writes a point's own entries of next and normals.
-  std::vector<double> cur(3 * n), next(3 * n), normals(3 * n, 0.0);
+  PrefaultVector<double> cur(3 * n), next(3 * n), normals(3 * n, 0.0);
   for (size_t q = 0; q < n; ++q)
     std::memcpy(&cur[3 * q], &xyz[3 * size_t(nb.order[q])], 3 * sizeof(double));
   for_blocks(n, threads, progress, 0.4, 0.5, [&](size_t begin, size_t end) {

@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 namespace sc {
 
@@ -41,6 +42,9 @@ template <class T, class U>
 bool operator!=(const PrefaultAllocator<T> &, const PrefaultAllocator<U> &) {
   return false;
 }
+
+// A vector whose large buffers come resident in one call.
+template <class T> using PrefaultVector = std::vector<T, PrefaultAllocator<T>>;
 
 } // namespace sc
 
