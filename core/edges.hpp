@@ -10,6 +10,7 @@
 #define SC_CORE_EDGES_HPP
 
 #include "internal.hpp"
+#include "prefault.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -124,15 +125,16 @@ struct EdgeTable {
     const size_t nt = tris.size() / 3;
     // Bucket the entries by their smaller vertex (a counting sort), then
     // sort each small bucket: linear overall, unlike one global sort.
-    std::vector<uint32_t> count(n + 1, 0);
+    PrefaultVector<uint32_t> count(n + 1, 0);
     for (size_t i = 0; i < 3 * nt; ++i) {
       uint32_t a = tris[i], b = tris[i % 3 == 2 ? i - 2 : i + 1];
       ++count[std::min(a, b) + 1];
     }
     for (size_t v = 0; v < n; ++v)
       count[v + 1] += count[v];
+    reserve_resident(entries, 3 * nt);
     entries.resize(3 * nt);
-    std::vector<uint32_t> fill(count.begin(), count.end() - 1);
+    PrefaultVector<uint32_t> fill(count.begin(), count.end() - 1);
     for (size_t t = 0; t < nt; ++t) {
       progress.tick(t, 2 * nt);
       for (int k = 0; k < 3; ++k) {
@@ -151,6 +153,7 @@ struct EdgeTable {
     angle.clear();
     if (!angles)
       return;
+    reserve_resident(angle, entries.size());
     angle.resize(entries.size());
     // Each edge's frame once, then its triangles by angle (ties by number).
     for (size_t e = 0; e + 1 < first.size(); ++e) {
@@ -262,6 +265,11 @@ struct EdgeTable {
   // triangles (ticking the second half of build()'s progress when given).
   void index_edges(size_t nt, Progress *progress, bool with_tri_edge) {
     first.clear();
+    // Edges are about half the entries (a surface's edges have two
+    // triangles each).
+    reserve_resident(first, entries.size() / 2 + 1);
+    tri_edge.clear();
+    reserve_resident(tri_edge, with_tri_edge ? 3 * nt : 0);
     tri_edge.assign(with_tri_edge ? 3 * nt : 0, 0);
     for (size_t i = 0; i < entries.size(); ++i) {
       if (progress)
@@ -341,6 +349,8 @@ struct VertexStar {
   VertexStar &operator=(const VertexStar &) = delete;
   template <class Keep>
   void build(size_t n, const std::vector<uint32_t> &t, Keep keep) {
+    first.clear();
+    reserve_resident(first, n + 1);
     first.assign(n + 1, 0);
     const size_t nt = t.size() / 3;
     for (size_t i = 0; i < nt; ++i)
@@ -349,8 +359,9 @@ struct VertexStar {
           ++first[t[3 * i + k] + 1];
     for (size_t v = 0; v < n; ++v)
       first[v + 1] += first[v];
+    reserve_resident(tris, first[n]);
     tris.resize(first[n]);
-    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+    PrefaultVector<uint32_t> fill(first.begin(), first.end() - 1);
     for (size_t i = 0; i < nt; ++i)
       if (keep(i))
         for (int k = 0; k < 3; ++k)

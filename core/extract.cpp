@@ -22,6 +22,7 @@ std::vector<uint32_t> by_decreasing_x(const double *xyz, size_t n,
     uint32_t v;
   };
   std::vector<ByX> by_x;
+  reserve_resident(by_x, n);
   for (uint32_t v = 0; v < n; ++v)
     if (star.first[v + 1] > star.first[v])
       by_x.push_back({xyz[3 * size_t(v)], v});
@@ -44,12 +45,21 @@ public:
   Walk(const double *xyz, size_t n, const std::vector<uint32_t> &live,
        const EdgeTable &et, const VertexStar &star, bool breadth_first,
        Progress &progress)
-      : otri(live), in(live.size() / 3, 0), xyz_(xyz), live_(live), et_(et),
-        star_(star), progress_(progress), nl_(live.size() / 3),
-        used_(et.edges(), 0), owner_(n, -1), etri_(et.entries.size()),
-        breadth_first_(breadth_first) {
+      : xyz_(xyz), live_(live), et_(et), star_(star), progress_(progress),
+        nl_(live.size() / 3), breadth_first_(breadth_first) {
+    // (Each array resident at once: prefault.hpp.)
+    reserve_resident(otri, live.size());
+    otri.assign(live.begin(), live.end());
+    reserve_resident(in, nl_);
+    in.assign(nl_, 0);
+    reserve_resident(used_, et.edges());
+    used_.assign(et.edges(), 0);
+    reserve_resident(owner_, n);
+    owner_.assign(n, -1);
     // The triangles of the edge table alone, side by side: the walk reads
     // little else of an entry, at every edge it crosses.
+    reserve_resident(etri_, et.entries.size());
+    etri_.resize(et.entries.size());
     for (size_t i = 0; i < etri_.size(); ++i)
       etri_[i] = et.entries[i].tri;
   }
@@ -256,6 +266,14 @@ private:
 
 } // namespace
 
+namespace {
+// The entries of the triangles marked in `keep`.
+size_t live_count(const std::vector<uint8_t> &keep) {
+  return 3 * size_t(std::count_if(keep.begin(), keep.end(),
+                                  [](uint8_t k) { return k != 0; }));
+}
+} // namespace
+
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, EdgeTablePtr table,
              size_t max_hole, const std::vector<uint8_t> &boundary,
@@ -264,6 +282,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   const size_t nt = cand.size() / 3;
   // Only the survivors of pruning take part.
   std::vector<uint32_t> live;
+  reserve_resident(live, live_count(alive));
   for (size_t t = 0; t < nt; ++t)
     if (alive[t])
       live.insert(live.end(), &cand[3 * t], &cand[3 * t] + 3);
@@ -286,6 +305,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   // The output, its components (triangles sharing an edge), and their
   // topology. Closed components facing inward are flipped.
   std::vector<uint32_t> res;
+  reserve_resident(res, live_count(in));
   for (size_t t = 0; t < nl; ++t)
     if (in[t])
       res.insert(res.end(), &otri[3 * t], &otri[3 * t] + 3);

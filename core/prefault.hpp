@@ -43,6 +43,16 @@ bool operator!=(const PrefaultAllocator<T> &, const PrefaultAllocator<U> &) {
   return false;
 }
 
+// Room in v for m elements, the pages beyond its size resident at once:
+// for a vector about to be resized or filled to m.
+template <class T, class A>
+void reserve_resident(std::vector<T, A> &v, size_t m) {
+  if (v.capacity() >= m)
+    return;
+  v.reserve(m);
+  prefault(v.data() + v.size(), (m - v.size()) * sizeof(T));
+}
+
 // A vector whose large buffers come resident in one call.
 template <class T> using PrefaultVector = std::vector<T, PrefaultAllocator<T>>;
 

@@ -88,11 +88,15 @@ inline Box grown(const Box &b, double d) {
 // changes after construction.
 class PointTree {
 public:
-  PointTree(const double *pts, size_t m) : pts_(pts), idx_(m) {
+  PointTree(const double *pts, size_t m) : pts_(pts) {
+    // (Its arrays resident at once: prefault.hpp.)
+    reserve_resident(idx_, m);
+    idx_.resize(m);
     std::iota(idx_.begin(), idx_.end(), 0u);
     if (m)
       build(0, m);
     // The points again in the tree's order, so that a leaf's are together.
+    reserve_resident(xyz_, 3 * m);
     xyz_.resize(3 * m);
     for (size_t i = 0; i < m; ++i)
       std::memcpy(&xyz_[3 * i], pts_ + 3 * size_t(idx_[i]), 3 * sizeof(double));
@@ -1113,10 +1117,14 @@ Numbering number_points(const double *xyz, size_t n,
                         sc_diag_t &diag) {
   Numbering num;
   {
-    std::vector<uint32_t> order(n);
+    // (The arrays resident at once: prefault.hpp.)
+    std::vector<uint32_t> order;
+    reserve_resident(order, n);
+    order.resize(n);
     std::iota(order.begin(), order.end(), 0u);
     hilbert_sort(xyz, order);
     out.to_input.clear();
+    reserve_resident(out.to_input, n);
     for (uint32_t i : order)
       if (is_vertex[i])
         out.to_input.push_back(i);
@@ -1125,14 +1133,17 @@ Numbering number_points(const double *xyz, size_t n,
   const size_t m = out.to_input.size();
   diag.duplicates_merged = out.dups.size();
   diag.delaunay_vertices = m;
+  reserve_resident(num.rank, n);
   num.rank.assign(n, UINT32_MAX);
   for (size_t v = 0; v < m; ++v)
     num.rank[out.to_input[v]] = uint32_t(v);
   if (!ts)
     return num;
+  reserve_resident(num.pts, 3 * m);
   num.pts.resize(3 * m);
+  reserve_resident(num.owner, m);
   num.owner.resize(m);
-  std::vector<uint16_t> tile_of(n);
+  PrefaultVector<uint16_t> tile_of(n);
   for (const Tile &t : *ts)
     for (uint32_t i : t.own)
       tile_of[i] = t.id;
