@@ -264,14 +264,12 @@ private:
   size_t added_ = 0;
 };
 
-} // namespace
-
-namespace {
 // The entries of the triangles marked in `keep`.
 size_t live_count(const std::vector<uint8_t> &keep) {
   return 3 * size_t(std::count_if(keep.begin(), keep.end(),
                                   [](uint8_t k) { return k != 0; }));
 }
+
 } // namespace
 
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
