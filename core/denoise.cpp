@@ -552,7 +552,6 @@ public:
       keys_[i] = kv[i].first;
       order_[i] = kv[i].second;
     }
-    index_cells();
   }
   uint64_t key_of(const double *p) const {
     uint64_t key = 0;
@@ -560,72 +559,14 @@ public:
       key = (key << 21) | uint64_t((p[a] - lo_[a]) / side_);
     return key;
   }
-  // The points sorted by cell, and their keys.
+  // The points sorted by cell (for the taking), and their keys.
   PrefaultVector<uint32_t> &order() { return order_; }
   const PrefaultVector<uint64_t> &keys() const { return keys_; }
-  // The range [first, last) of order() in the cells of keys lo to hi
-  // (consecutive keys: a run of cells along z), empty when they are.
-  void cells(uint64_t lo, uint64_t hi, size_t *first, size_t *last) const {
-    *first = *last = 0;
-    for (uint64_t key = lo; key <= hi; ++key) {
-      const Slot *s = find(key);
-      if (!s)
-        continue;
-      if (*first == *last)
-        *first = s->first;
-      *last = s->last;
-    }
-  }
 
 private:
-  // The cells that hold points, in an open-addressing hash table: a
-  // neighbourhood's 21 runs of cells are a hundred lookups in a table
-  // the size of the cells, where binary searches over the keys of all the
-  // points took 40 steps through a much larger array.
-  struct Slot {
-    uint64_t key; // kEmpty: none
-    uint32_t first, last;
-  };
-  static constexpr uint64_t kEmpty = ~uint64_t(0); // keys use 63 bits
-  static size_t hash(uint64_t key) {
-    key *= 0x9E3779B97F4A7C15ull;
-    return size_t(key ^ (key >> 32));
-  }
-  void index_cells() {
-    size_t cells = 0;
-    for (size_t i = 0; i < keys_.size(); ++i)
-      cells += i == 0 || keys_[i] != keys_[i - 1];
-    size_t size = 2;
-    while (size < 2 * cells)
-      size <<= 1;
-    mask_ = size - 1;
-    slots_.assign(size, Slot{kEmpty, 0, 0});
-    for (size_t i = 0; i < keys_.size();) {
-      size_t j = i + 1;
-      while (j < keys_.size() && keys_[j] == keys_[i])
-        ++j;
-      size_t h = hash(keys_[i]) & mask_;
-      while (slots_[h].key != kEmpty)
-        h = (h + 1) & mask_;
-      slots_[h] = Slot{keys_[i], uint32_t(i), uint32_t(j)};
-      i = j;
-    }
-  }
-  const Slot *find(uint64_t key) const {
-    for (size_t h = hash(key) & mask_;; h = (h + 1) & mask_) {
-      const Slot &s = slots_[h];
-      if (s.key == key)
-        return &s;
-      if (s.key == kEmpty)
-        return nullptr;
-    }
-  }
-
   double side_, lo_[3];
   PrefaultVector<uint32_t> order_;
   PrefaultVector<uint64_t> keys_;
-  PrefaultVector<Slot> slots_;
-  size_t mask_ = 0;
 };
 
 // Points per block of smoothing's loops, which run on the job's threads.
@@ -699,7 +640,13 @@ void find_neighbours(const double *xyz, size_t n, double r, unsigned threads,
           const uint64_t k0 = (uint64_t(int64_t(cx) + dx) << 42) |
                               (uint64_t(int64_t(cy) + dy) << 21) |
                               ((key & kAxis) - 2);
-          grid.cells(k0, k0 + 4, &ranges[nr][0], &ranges[nr][1]);
+          // Columns after this cell's start after the points of it.
+          const bool after = dx > 0 || (dx == 0 && dy > 0);
+          const auto lo = std::lower_bound(
+              keys.begin() + (after ? long(first) : 0), keys.end(), k0);
+          const auto hi = std::upper_bound(lo, keys.end(), k0 + 4);
+          ranges[nr][0] = size_t(lo - keys.begin());
+          ranges[nr][1] = size_t(hi - keys.begin());
           if (ranges[nr][0] < ranges[nr][1])
             ++nr;
         }
