@@ -34,19 +34,25 @@ std::vector<uint32_t> by_decreasing_x(const double *xyz, size_t n,
   return order;
 }
 
+// The walk never crosses to a triangle that bends back onto the one it
+// comes from by more than 120 degrees (a fold into a pocket of extra
+// candidates), nor to one whose longest edge is more than 4 times that of
+// the one it comes from (a bridge across a gap): section 8.
+constexpr double kMinFlat = -0.5;
+constexpr double kMaxGrowth = 4;
+
 // The walk: grow each component from a seed triangle, crossing every edge
 // to the first triangle met when rotating about it from the outer side,
-// breadth or depth first (docs/algorithm.md section 8).
+// the flattest continuation first (docs/algorithm.md section 8).
 // A triangle joins only if it keeps every directed edge used at most once
 // (edge-manifold, consistently oriented) and touches no vertex of an
 // earlier component.
 class Walk {
 public:
   Walk(const double *xyz, size_t n, const std::vector<uint32_t> &live,
-       const EdgeTable &et, const VertexStar &star, bool breadth_first,
-       Progress &progress)
+       const EdgeTable &et, const VertexStar &star, Progress &progress)
       : xyz_(xyz), live_(live), et_(et), star_(star), progress_(progress),
-        nl_(live.size() / 3), breadth_first_(breadth_first) {
+        nl_(live.size() / 3) {
     // (Each array resident at once: prefault.hpp.)
     reserve_resident(otri, live.size());
     otri.assign(live.begin(), live.end());
@@ -109,19 +115,30 @@ private:
   }
 
   // Adds live triangle t, as a -> b -> c, to component comp if it may join.
-  bool try_add(uint32_t t, uint32_t a, uint32_t b, uint32_t c, int32_t comp) {
+  // Whether live triangle t, as a -> b -> c, may join component comp; its
+  // edges' ids in e. Once false, false for the rest of the walk: owners
+  // and used directions are only added.
+  bool may_join(uint32_t t, uint32_t a, uint32_t b, uint32_t c, int32_t comp,
+                uint32_t e[3]) const {
     const uint32_t v[3] = {a, b, c};
     for (int k = 0; k < 3; ++k) {
       if (owner_[v[k]] != -1 && owner_[v[k]] != comp)
         return false;
     }
-    uint32_t e[3];
     for (int k = 0; k < 3; ++k) {
       uint32_t x = v[k], y = v[(k + 1) % 3];
       e[k] = edge_of(t, x, y);
       if (used_[e[k]] & dir_bit(x, y))
         return false;
     }
+    return true;
+  }
+
+  bool try_add(uint32_t t, uint32_t a, uint32_t b, uint32_t c, int32_t comp) {
+    const uint32_t v[3] = {a, b, c};
+    uint32_t e[3];
+    if (!may_join(t, a, b, c, comp, e))
+      return false;
     // A corner already in the component that shares neither of its edges
     // with a triangle of it starts a second fan there, which later
     // triangles may or may not join to the first.
@@ -178,52 +195,106 @@ private:
     return best;
   }
 
-  // Grows component comp from the seed, a -> b -> c; its triangles are
-  // left in members_ (none if the seed could not join).
+  // The unit normal of the triangle a -> b -> c (zero if it has no area).
+  void unit_normal(uint32_t a, uint32_t b, uint32_t c, double nrm[3]) const {
+    const double *p = xyz_ + 3 * size_t(a), *q = xyz_ + 3 * size_t(b),
+                 *r = xyz_ + 3 * size_t(c);
+    const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+    const double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+    nrm[0] = u[1] * w[2] - u[2] * w[1];
+    nrm[1] = u[2] * w[0] - u[0] * w[2];
+    nrm[2] = u[0] * w[1] - u[1] * w[0];
+    const double l =
+        std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    for (int k = 0; k < 3; ++k)
+      nrm[k] = l > 0 ? nrm[k] / l : 0;
+  }
+
+  // The squared length of the longest edge of triangle a, b, c.
+  double longest2(uint32_t a, uint32_t b, uint32_t c) const {
+    auto d2 = [&](uint32_t i, uint32_t j) {
+      const double *p = xyz_ + 3 * size_t(i), *q = xyz_ + 3 * size_t(j);
+      return (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+             (p[2] - q[2]) * (p[2] - q[2]);
+    };
+    return std::max(d2(a, b), std::max(d2(b, c), d2(c, a)));
+  }
+
+  // A triangle that may join next, oriented a -> b -> c to follow the one
+  // it was met from.
+  struct Step {
+    uint32_t t, a, b, c;
+  };
+  // The bend of a step in whole degrees, 0 to 120: the queue of each
+  // degree is taken in the order its steps were met, the flattest first.
+  static constexpr int kBends = 121;
+  static constexpr double kDegrees = 180 / 3.14159265358979323846;
+
+  // Offers the triangle met across each edge of t (the first when rotating
+  // about the edge from t's outer side), unless it folds back onto t or
+  // is much larger than t (section 8).
+  void offer_next(uint32_t t, int32_t comp) {
+    const uint32_t *o = &otri[3 * size_t(t)];
+    double nt[3];
+    unit_normal(o[0], o[1], o[2], nt);
+    const double lt = longest2(o[0], o[1], o[2]);
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t x = o[k], y = o[(k + 1) % 3];
+      const uint32_t e = edge_of(t, x, y);
+      const uint32_t lo = et_.first[e], cnt = et_.first[e + 1] - lo;
+      // Nothing to cross to, or the other side is already taken.
+      if (cnt < 2 || (used_[e] & dir_bit(y, x)))
+        continue;
+      uint32_t pos = 0;
+      while (etri_[lo + pos] != t)
+        ++pos;
+      // Rotating toward the outer side of t is increasing angle when t
+      // runs along the edge's reference direction, decreasing otherwise.
+      const uint32_t step = x < y ? 1 : cnt - 1;
+      const uint32_t nb = etri_[lo + (pos + step) % cnt];
+      if (in[nb])
+        continue;
+      const uint32_t *w = &live_[3 * size_t(nb)];
+      const uint32_t z = w[0] != x && w[0] != y   ? w[0]
+                         : w[1] != x && w[1] != y ? w[1]
+                                                  : w[2];
+      // (What cannot join now never will: no need to queue it.)
+      uint32_t ne[3];
+      if (!may_join(nb, y, x, z, comp, ne))
+        continue;
+      double nn[3];
+      unit_normal(y, x, z, nn);
+      const double flat = nt[0] * nn[0] + nt[1] * nn[1] + nt[2] * nn[2];
+      if (flat < kMinFlat || longest2(y, x, z) > kMaxGrowth * kMaxGrowth * lt)
+        continue;
+      const int bend =
+          std::min(kBends - 1, int(std::acos(std::min(1.0, flat)) * kDegrees));
+      queue_[bend].push_back({nb, y, x, z});
+      least_ = std::min(least_, bend);
+    }
+  }
+
+  // Grows component comp from the seed, a -> b -> c, flattest step first;
+  // its triangles are left in members_ (none if the seed could not join).
   void walk(uint32_t seed, uint32_t a, uint32_t b, uint32_t c, int32_t comp) {
     members_.clear();
     if (!try_add(seed, a, b, c, comp))
       return;
     members_.push_back(seed);
-    // Breadth first, the triangles taken are the queue: members_[next ..).
-    // Depth first, a stack of its own.
-    size_t next = 0;
-    if (!breadth_first_)
-      stack_.assign(1, seed);
-    while (breadth_first_ ? next < members_.size() : !stack_.empty()) {
-      progress_.tick(++added_, 2 * nl_);
-      uint32_t t;
-      if (breadth_first_) {
-        t = members_[next++];
-      } else {
-        t = stack_.back();
-        stack_.pop_back();
+    offer_next(seed, comp);
+    while (least_ < kBends) {
+      std::vector<Step> &q = queue_[least_];
+      if (head_[least_] == q.size()) {
+        q.clear();
+        head_[least_] = 0;
+        ++least_;
+        continue;
       }
-      for (int k = 0; k < 3; ++k) {
-        uint32_t x = otri[3 * size_t(t) + k],
-                 y = otri[3 * size_t(t) + (k + 1) % 3];
-        uint32_t e = edge_of(t, x, y);
-        uint32_t lo = et_.first[e], cnt = et_.first[e + 1] - lo;
-        if (cnt < 2)
-          continue;
-        uint32_t pos = 0;
-        while (etri_[lo + pos] != t)
-          ++pos;
-        // Rotating toward the outer side of t is increasing angle when t
-        // runs along the edge's reference direction, decreasing otherwise.
-        uint32_t step = x < y ? 1 : cnt - 1;
-        uint32_t nb = etri_[lo + (pos + step) % cnt];
-        if (in[nb])
-          continue;
-        const uint32_t *w = &live_[3 * size_t(nb)];
-        uint32_t z = w[0] != x && w[0] != y   ? w[0]
-                     : w[1] != x && w[1] != y ? w[1]
-                                              : w[2];
-        if (try_add(nb, y, x, z, comp)) {
-          members_.push_back(nb);
-          if (!breadth_first_)
-            stack_.push_back(nb);
-        }
+      const Step s = q[head_[least_]++];
+      progress_.tick(++added_, 3 * nl_); // each offers at most 3
+      if (!in[s.t] && try_add(s.t, s.a, s.b, s.c, comp)) {
+        members_.push_back(s.t);
+        offer_next(s.t, comp);
       }
     }
   }
@@ -259,8 +330,10 @@ private:
   std::vector<uint8_t> used_;  // per edge: the directions used (dir_bit())
   std::vector<int32_t> owner_; // per vertex: its component, or -1
   std::vector<uint32_t> etri_;
-  const bool breadth_first_;
-  std::vector<uint32_t> members_, stack_;
+  std::vector<uint32_t> members_;
+  std::vector<Step> queue_[kBends];
+  size_t head_[kBends] = {};
+  int least_ = kBends; // no queue below it holds a step
   size_t added_ = 0;
 };
 
@@ -275,8 +348,8 @@ size_t live_count(const std::vector<uint8_t> &keep) {
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, EdgeTablePtr table,
              size_t max_hole, const std::vector<uint8_t> &boundary,
-             bool breadth_first, Progress &progress, Surface &out,
-             sc_diag_t &diag, bool check_vertices) {
+             Progress &progress, Surface &out, sc_diag_t &diag,
+             bool check_vertices) {
   const size_t nt = cand.size() / 3;
   // Only the survivors of pruning take part.
   std::vector<uint32_t> live;
@@ -291,7 +364,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   star.build(n, live, [](size_t) { return true; });
 
   const std::vector<uint32_t> order = by_decreasing_x(xyz, n, star);
-  Walk walk(xyz, n, live, et, star, breadth_first, progress);
+  Walk walk(xyz, n, live, et, star, progress);
   walk.run(order);
   std::vector<uint32_t> &otri = walk.otri;
   std::vector<uint8_t> &in = walk.in;

@@ -60,10 +60,11 @@ public:
       throw Error(SC_ECANCELLED, "cancelled during stage " +
                                      std::string(sc_stage_name(stage_)));
   }
-  // For loops: report every `every` iterations (a power of two).
+  // For loops: report every `every` iterations (a power of two); i of
+  // about n, never more than the whole.
   void tick(size_t i, size_t n, size_t every = 1u << 15) {
     if (fn_ && (i & (every - 1)) == 0)
-      report(n ? double(i) / double(n) : 1.0);
+      report(n && i < n ? double(i) / double(n) : 1.0);
   }
 
 private:
@@ -228,15 +229,15 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
            Progress &progress, sc_diag_t &diag);
 // The walk and small holes (sections 8 and 9). Takes the table prune()
 // left for the same candidates and alive flags. Holes mostly rimmed by
-// samples marked in boundary are left open. The walk grows breadth first
-// or depth first (section 8).
+// samples marked in boundary are left open. The walk takes the flattest
+// continuation first (section 8).
 // `check_vertices` as in describe(): pass false only when an open surface
 // will be described again before it is output.
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, EdgeTablePtr table,
              size_t max_hole, const std::vector<uint8_t> &boundary,
-             bool breadth_first, Progress &progress, Surface &out,
-             sc_diag_t &diag, bool check_vertices = true);
+             Progress &progress, Surface &out, sc_diag_t &diag,
+             bool check_vertices = true);
 // The topology of a finished surface (section 10): components, boundary loops,
 // genus, manifold checks; closed components facing inward are flipped. Resets
 // and fills the output fields of diag (triangles, boundary, components ...).

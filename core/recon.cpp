@@ -614,13 +614,9 @@ sc_mesh_t *Recon::finish() {
   const bool scan_holes = watertight && !f.boundary.empty();
   // Watertight mode describes an open surface again once it is closed,
   // and checks its vertices then (fix_fans_in() leaves one fan at each).
-  // The walk grows breadth first, but where boundary samples were found
-  // it keeps the depth-first order that watertight mode's handle cutting
-  // was measured on (section 8). So a boundary mode that finds none runs
-  // exactly the cocone mode.
   extract(lxyz.data(), m, f.tris, alive, std::move(table),
-          scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary,
-          diag.boundary_samples == 0, progress, surf, diag, !watertight);
+          scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary, progress,
+          surf, diag, !watertight);
   if (detects_boundary(params_.mode)) {
     // Real scans: overlapping layers leave bubbles, small closed components
     // between them, and samples the walk passed by. Drop the bubbles;
@@ -700,7 +696,7 @@ void Recon::check_topology(const double *lxyz, size_t m, Filtered &f,
     prune(lxyz, m, cand, params_.paper_pruning != 0, f.boundary, alive, table,
           progress, d);
     extract(lxyz, m, cand, alive, std::move(table),
-            size_t(params_.max_hole_edges), f.boundary, true, progress, s, d);
+            size_t(params_.max_hole_edges), f.boundary, progress, s, d);
   };
   sc_diag_t cd = before;
   Surface cs;
