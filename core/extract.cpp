@@ -114,7 +114,6 @@ private:
     return uint32_t(UINT32_MAX);
   }
 
-  // Adds live triangle t, as a -> b -> c, to component comp if it may join.
   // Whether live triangle t, as a -> b -> c, may join component comp; its
   // edges' ids in e. Once false, false for the rest of the walk: owners
   // and used directions are only added.
@@ -134,6 +133,7 @@ private:
     return true;
   }
 
+  // Adds live triangle t, as a -> b -> c, to component comp if it may join.
   bool try_add(uint32_t t, uint32_t a, uint32_t b, uint32_t c, int32_t comp) {
     const uint32_t v[3] = {a, b, c};
     uint32_t e[3];
