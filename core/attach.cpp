@@ -56,11 +56,6 @@ void closest_on_triangle(const double *p, const double *a, const double *b,
   w[1] = vb * den, w[2] = vc * den, w[0] = 1 - w[1] - w[2];
 }
 
-double dist2(const double *x, const double *y) {
-  double d[3] = {x[0] - y[0], x[1] - y[1], x[2] - y[2]};
-  return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-}
-
 // Stars that change as triangles split: each vertex's triangles at the
 // start, then those it gained, in a list per vertex in the order gained
 // (a vector per vertex cost an allocation each and 24 bytes a vertex). A

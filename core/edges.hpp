@@ -24,6 +24,25 @@ inline double dot3(const double *x, const double *y) {
   return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
 }
 
+// The squared distance of points x and y.
+inline double dist2(const double *x, const double *y) {
+  const double d[3] = {x[0] - y[0], x[1] - y[1], x[2] - y[2]};
+  return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+// The normal of triangle a -> b -> c of the points xyz, (b - a) x (c - a):
+// twice its area long.
+inline void triangle_normal(const double *xyz, uint32_t a, uint32_t b,
+                            uint32_t c, double n[3]) {
+  const double *p = xyz + 3 * size_t(a), *q = xyz + 3 * size_t(b),
+               *r = xyz + 3 * size_t(c);
+  const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+  const double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+  n[0] = u[1] * w[2] - u[2] * w[1];
+  n[1] = u[2] * w[0] - u[0] * w[2];
+  n[2] = u[0] * w[1] - u[1] * w[0];
+}
+
 inline uint64_t edge_key(uint32_t a, uint32_t b) {
   return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a;
 }

@@ -177,19 +177,15 @@ private:
       if (in[t] || owner_[v[0]] != -1 || owner_[v[1]] != -1 ||
           owner_[v[2]] != -1 || !clean(t))
         continue;
-      const double *a = xyz_ + 3 * size_t(v[0]), *b = xyz_ + 3 * size_t(v[1]),
-                   *c = xyz_ + 3 * size_t(v[2]);
-      double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-      double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-      double nx = u[1] * w[2] - u[2] * w[1], ny = u[2] * w[0] - u[0] * w[2],
-             nz = u[0] * w[1] - u[1] * w[0];
-      double l = std::sqrt(nx * nx + ny * ny + nz * nz);
+      double nrm[3];
+      triangle_normal(xyz_, v[0], v[1], v[2], nrm);
+      const double l = std::sqrt(dot3(nrm, nrm));
       if (!(l > 0))
         continue;
-      if (std::fabs(nx) / l > best_nx) {
-        best_nx = std::fabs(nx) / l;
+      if (std::fabs(nrm[0]) / l > best_nx) {
+        best_nx = std::fabs(nrm[0]) / l;
         best = t;
-        sign = nx >= 0 ? 1 : -1;
+        sign = nrm[0] >= 0 ? 1 : -1;
       }
     }
     return best;
@@ -197,27 +193,17 @@ private:
 
   // The unit normal of the triangle a -> b -> c (zero if it has no area).
   void unit_normal(uint32_t a, uint32_t b, uint32_t c, double nrm[3]) const {
-    const double *p = xyz_ + 3 * size_t(a), *q = xyz_ + 3 * size_t(b),
-                 *r = xyz_ + 3 * size_t(c);
-    const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
-    const double w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
-    nrm[0] = u[1] * w[2] - u[2] * w[1];
-    nrm[1] = u[2] * w[0] - u[0] * w[2];
-    nrm[2] = u[0] * w[1] - u[1] * w[0];
-    const double l =
-        std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    triangle_normal(xyz_, a, b, c, nrm);
+    const double l = std::sqrt(dot3(nrm, nrm));
     for (int k = 0; k < 3; ++k)
       nrm[k] = l > 0 ? nrm[k] / l : 0;
   }
 
   // The squared length of the longest edge of triangle a, b, c.
   double longest2(uint32_t a, uint32_t b, uint32_t c) const {
-    auto d2 = [&](uint32_t i, uint32_t j) {
-      const double *p = xyz_ + 3 * size_t(i), *q = xyz_ + 3 * size_t(j);
-      return (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-             (p[2] - q[2]) * (p[2] - q[2]);
-    };
-    return std::max(d2(a, b), std::max(d2(b, c), d2(c, a)));
+    const double *p = xyz_ + 3 * size_t(a), *q = xyz_ + 3 * size_t(b),
+                 *r = xyz_ + 3 * size_t(c);
+    return std::max(dist2(p, q), std::max(dist2(q, r), dist2(r, p)));
   }
 
   // A triangle that may join next, oriented a -> b -> c to follow the one
@@ -264,7 +250,7 @@ private:
         continue;
       double nn[3];
       unit_normal(y, x, z, nn);
-      const double flat = nt[0] * nn[0] + nt[1] * nn[1] + nt[2] * nn[2];
+      const double flat = dot3(nt, nn);
       if (flat < kMinFlat || longest2(y, x, z) > kMaxGrowth * kMaxGrowth * lt)
         continue;
       const int bend =
