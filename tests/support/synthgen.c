@@ -3,7 +3,10 @@
  * Gaussian noise of a given multiple of the sample spacing, as an .xyz
  * file, for the shell tests of the commands.
  *
- *   synthgen SURFACE N SIGMA SEED OUT.xyz
+ *   synthgen SURFACE N SIGMA SEED OUT.xyz [DENSITY]
+ *
+ * DENSITY is uniform (well spaced, the default), uniform-random or
+ * adaptive (denser where the surface curves more).
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -14,19 +17,23 @@
 #include "synth.h"
 
 int main(int argc, char **argv) {
-  if (argc != 6) {
-    fprintf(stderr, "usage: %s SURFACE N SIGMA SEED OUT.xyz\n", argv[0]);
+  if (argc != 6 && argc != 7) {
+    fprintf(stderr, "usage: %s SURFACE N SIGMA SEED OUT.xyz [DENSITY]\n",
+            argv[0]);
     return 2;
   }
   const int s = scs_surface_from_name(argv[1]);
+  const int d =
+      argc == 7 ? scs_density_from_name(argv[6]) : SCS_DENSITY_UNIFORM;
   const size_t n = strtoul(argv[2], NULL, 10);
   const double sigma = atof(argv[3]);
   const uint64_t seed = strtoull(argv[4], NULL, 10);
   double *xyz = malloc(3 * n * sizeof *xyz);
-  if (s < 0 || n < 4 || !xyz ||
-      scs_sample_surface((scs_surface_t)s, SCS_DENSITY_UNIFORM, n, seed, xyz) !=
+  if (s < 0 || d < 0 || n < 4 || !xyz ||
+      scs_sample_surface((scs_surface_t)s, (scs_density_t)d, n, seed, xyz) !=
           0) {
-    fprintf(stderr, "%s: bad surface or count, or sampling failed\n", argv[0]);
+    fprintf(stderr, "%s: bad surface, density or count, or sampling failed\n",
+            argv[0]);
     return 1;
   }
   scs_add_noise(xyz, n, sigma * scs_surface_spacing((scs_surface_t)s, n),
