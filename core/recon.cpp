@@ -31,6 +31,9 @@ constexpr uint64_t kMaxFillWork = 2000000000ull;
 // Closed components of fewer triangles than this, or than a thousandth of
 // the surface, are bubbles between scan layers in the modes for scans.
 constexpr size_t kMinBubble = 8;
+// Watertight mode keeps a triangulation of at most this many points for
+// the labelling (section 11.5): about 70 MB at most.
+constexpr size_t kKeepForLabels = 65536;
 // Denoising (and auto mode) smooths the points when the estimated noise
 // is at least this many spacings (README, "Noise"; measured with
 // shortcrust-noise-table and on the shared closed models).
@@ -565,12 +568,17 @@ sc_mesh_t *Recon::finish() {
     // the rest, exactly.
     if (dt_raw_ && !shifted_.empty())
       dt_->translate(shift_);
-    // Watertight mode's labelling alone (--labels) labels the cells of
-    // this triangulation (section 11.4). Otherwise it goes: the labelling
-    // runs only where the patches leave doubt (close_surface()), and then
-    // on the same triangulation built again, so that the peak memory stays
-    // that of the patches where they suffice.
-    dt_->keep = params_.mode == SC_MODE_WATERTIGHT && params_.watertight_labels;
+    // Watertight mode's labelling (section 11.4) labels the cells of this
+    // triangulation with --labels, and by default where it is small
+    // (kKeepForLabels): building it again would cost as much as the first
+    // construction. A larger one goes: the labelling runs only where the
+    // patches leave doubt (close_surface()), and then on the same
+    // triangulation built again, so that the peak memory stays that of the
+    // patches where they suffice. (The triangulation is the same either
+    // way: CGAL's perturbation of cospherical points does not depend on
+    // the order of insertion.)
+    dt_->keep = params_.mode == SC_MODE_WATERTIGHT &&
+                (params_.watertight_labels || n_ <= kKeepForLabels);
     dt_->filter(work, n_, params_, progress, f, diag, seconds_);
     if (dt_->keep)
       kept_ = std::move(dt_);
