@@ -301,6 +301,10 @@ public:
     // The triangulation is not needed any more: free it before pruning so
     // that the peak memory is the triangulation's alone (watertight mode's
     // labelling alone keeps it, where it would otherwise build it again).
+    if (!keep && keep_boundary_share > 0 &&
+        double(diag.boundary_samples) >=
+            keep_boundary_share * double(out.to_input.size()))
+      keep = true;
     if (!keep)
       dt_.clear();
     // Which cell reports a facet, and when, depends on heap addresses; the

@@ -32,8 +32,10 @@ constexpr uint64_t kMaxFillWork = 2000000000ull;
 // the surface, are bubbles between scan layers in the modes for scans.
 constexpr size_t kMinBubble = 8;
 // Watertight mode keeps a triangulation of at most this many points for
-// the labelling (section 11.5): about 70 MB at most.
+// the labelling (section 11.5), about 70 MB at most, where at least this
+// share of the samples are boundary samples.
 constexpr size_t kKeepForLabels = 65536;
+constexpr double kKeepBoundaryShare = 0.1;
 // Denoising (and auto mode) smooths the points when the estimated noise
 // is at least this many spacings (README, "Noise"; measured with
 // shortcrust-noise-table and on the shared closed models).
@@ -569,16 +571,20 @@ sc_mesh_t *Recon::finish() {
     if (dt_raw_ && !shifted_.empty())
       dt_->translate(shift_);
     // Watertight mode's labelling (section 11.4) labels the cells of this
-    // triangulation with --labels, and by default where it is small
-    // (kKeepForLabels): building it again would cost as much as the first
-    // construction. A larger one goes: the labelling runs only where the
-    // patches leave doubt (close_surface()), and then on the same
-    // triangulation built again, so that the peak memory stays that of the
-    // patches where they suffice. (The triangulation is the same either
-    // way: CGAL's perturbation of cospherical points does not depend on
-    // the order of insertion.)
-    dt_->keep = params_.mode == SC_MODE_WATERTIGHT &&
-                (params_.watertight_labels || n_ <= kKeepForLabels);
+    // triangulation with --labels. By default the labelling runs only
+    // where the patches leave doubt (close_surface()), and the
+    // triangulation goes, so that the peak memory stays that of the
+    // patches where they suffice, and so that the stages after it reuse
+    // its pages; it is built again when the labelling runs. But where it is
+    // small (kKeepForLabels) and a tenth of the samples or more are
+    // boundary samples, the patches have nearly always left doubt (every
+    // closed model measured but the knot, the cheese and the bunny scans
+    // there, and none of those the patches closed), and it is kept: the
+    // second construction cost as much as the first.
+    const bool closing = params_.mode == SC_MODE_WATERTIGHT;
+    dt_->keep = closing && params_.watertight_labels;
+    dt_->keep_boundary_share =
+        closing && n_ <= kKeepForLabels ? kKeepBoundaryShare : 0;
     dt_->filter(work, n_, params_, progress, f, diag, seconds_);
     if (dt_->keep)
       kept_ = std::move(dt_);
