@@ -151,6 +151,34 @@ int scs_sample_surface(scs_surface_t s, int density, size_t n, uint64_t seed,
                        double *xyz);
 
 /*
+ * Writes n points (3n doubles) spread uniformly at random over the
+ * boundary of the union of nboxes axis-aligned boxes, each 6 doubles
+ * (the low corner, then the high one): closed surfaces with sharp edges
+ * and corners, thin parts and handles, whose topology follows from the
+ * boxes. Parts of faces inside other boxes, and faces that two boxes
+ * share, get no points. Bit-identical on every machine, as above.
+ * Returns 0, SCS_EINVAL (a box empty or inverted, boxes or xyz NULL, or a
+ * union whose faces are almost all inside it), or SCS_ENOMEM.
+ */
+int scs_sample_boxes(const double *boxes, size_t nboxes, size_t n,
+                     uint64_t seed, double *xyz);
+
+/*
+ * The boxes of a named shape for scs_sample_boxes(), for n samples, and
+ * its genus (one component); returns how many boxes, or 0 for an unknown
+ * name. Thin parts are two sample spacings thick.
+ *   cube   the unit cube: sharp edges and corners;
+ *   plate  a unit square plate: a thin part whose two sides are closer
+ *          than the samples on each are apart, at random, in many places;
+ *   fin    the unit cube with a fin standing out of one face: a thin part
+ *          joined to a body along sharp edges;
+ *   frame  a square frame (genus 1): a handle whose every edge is sharp.
+ */
+#define SCS_MAX_BOXES 4
+size_t scs_box_shape(const char *name, size_t n,
+                     double boxes[6 * SCS_MAX_BOXES], int *genus);
+
+/*
  * Distance from p to the surface (to the nearest component). Exact up to
  * rounding for the spheres and the torus. For the ellipsoid and the genus-2
  * surface it is |p - q| for a surface point q found by Newton projection and

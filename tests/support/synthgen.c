@@ -6,7 +6,10 @@
  *   synthgen SURFACE N SIGMA SEED OUT.xyz [DENSITY]
  *
  * DENSITY is uniform (well spaced, the default), uniform-random or
- * adaptive (denser where the surface curves more).
+ * adaptive (denser where the surface curves more). SURFACE may also be a
+ * shape of boxes with sharp edges (cube, plate, fin, frame:
+ * scs_box_shape()), sampled uniformly at random, without noise (SIGMA 0)
+ * or density.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -29,15 +32,27 @@ int main(int argc, char **argv) {
   const double sigma = atof(argv[3]);
   const uint64_t seed = strtoull(argv[4], NULL, 10);
   double *xyz = malloc(3 * n * sizeof *xyz);
-  if (s < 0 || d < 0 || n < 4 || !xyz ||
-      scs_sample_surface((scs_surface_t)s, (scs_density_t)d, n, seed, xyz) !=
-          0) {
-    fprintf(stderr, "%s: bad surface, density or count, or sampling failed\n",
+  double boxes[6 * SCS_MAX_BOXES];
+  int genus;
+  const size_t nboxes = scs_box_shape(argv[1], n, boxes, &genus);
+  int bad = n < 4 || !xyz;
+  if (!bad && nboxes > 0) /* no noise on those: their spacing is not kept */
+    bad = sigma != 0 || argc == 7 ||
+          scs_sample_boxes(boxes, nboxes, n, seed, xyz) != 0;
+  else if (!bad)
+    bad = s < 0 || d < 0 ||
+          scs_sample_surface((scs_surface_t)s, (scs_density_t)d, n, seed,
+                             xyz) != 0;
+  if (bad) {
+    fprintf(stderr,
+            "%s: bad surface, density or count (box shapes: no noise, no "
+            "density), or sampling failed\n",
             argv[0]);
     return 1;
   }
-  scs_add_noise(xyz, n, sigma * scs_surface_spacing((scs_surface_t)s, n),
-                seed + 1000);
+  if (nboxes == 0)
+    scs_add_noise(xyz, n, sigma * scs_surface_spacing((scs_surface_t)s, n),
+                  seed + 1000);
   FILE *f = fopen(argv[5], "w");
   if (!f) {
     perror(argv[5]);
