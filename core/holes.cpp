@@ -18,6 +18,9 @@ constexpr size_t kMinOpenLoop = 8;
 // percent of the surface's larger, the same loops and genus, as many
 // samples kept or more.)
 constexpr size_t kMaxPatch = 16;
+// A loop narrower than this many of its edges (median length) is a slit:
+// see is_slit().
+constexpr double kSlitWidth = 1.0;
 
 // Whether the triangle {a, b, c} is in tris, looked up through edge ab.
 bool is_triangle_of(const EdgeTable &et, const std::vector<uint32_t> &tris,
@@ -251,12 +254,46 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
   return true;
 }
 
+// Whether a loop (vertex numbers in order) is a slit: narrower than
+// kSlitWidth of its edges, its width taken as twice its vector area over
+// its length (the width of a long thin strip; the radius of a round
+// hole, so that a round hole of 8 edges or more is never a slit). Such a
+// strip of missing triangles is what the candidate tests leave along a
+// sharp edge or a crease, where the cells of the samples open sideways as
+// at the end of a surface; a hole in the surface itself, a scan's edge or
+// the gap between scans, is wide. (Measured: the loops that boundary mode
+// left open along the sharp edges and thin parts of closed models, 0.3 to
+// 2 of an edge, most under 1; the bunny scans' edges and holes, 4 to 38.)
+bool is_slit(const double *xyz, const std::vector<uint32_t> &loop) {
+  const size_t k = loop.size();
+  const double *o = xyz + 3 * size_t(loop[0]);
+  double area[3] = {0, 0, 0}, length = 0;
+  std::vector<double> edge(k);
+  for (size_t i = 0; i < k; ++i) {
+    const double *p = xyz + 3 * size_t(loop[i]),
+                 *q = xyz + 3 * size_t(loop[(i + 1) % k]);
+    const double a[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]},
+                 b[3] = {q[0] - o[0], q[1] - o[1], q[2] - o[2]};
+    area[0] += a[1] * b[2] - a[2] * b[1];
+    area[1] += a[2] * b[0] - a[0] * b[2];
+    area[2] += a[0] * b[1] - a[1] * b[0];
+    edge[i] = std::sqrt(dist2(p, q));
+    length += edge[i];
+  }
+  std::nth_element(edge.begin(), edge.begin() + k / 2, edge.end());
+  // Twice the vector area, |area| / 2, over the length.
+  const double width = std::sqrt(dot3(area, area)) / length;
+  return length > 0 && width <= kSlitWidth * edge[k / 2];
+}
+
 // The loops of the surface's holes that are to be filled, shortest first:
 // each a loop of at most max_loop edges (vertex numbers in order; the hole
-// runs along it), and not where the surface ends (see below).
+// runs along it) and not where the surface ends (see below), or a slit of
+// any length (is_slit()) where max_loop is not 0.
 std::vector<std::vector<uint32_t>>
-holes_to_fill(size_t n, const EdgeTable &et, const std::vector<uint32_t> &res,
-              size_t max_loop, const std::vector<uint8_t> &boundary) {
+holes_to_fill(const double *xyz, size_t n, const EdgeTable &et,
+              const std::vector<uint32_t> &res, size_t max_loop,
+              const std::vector<uint8_t> &boundary) {
   // The hole runs against the orientation of the triangle on each boundary
   // edge: a triangle with x -> y leaves the hole edge y -> x.
   std::vector<uint32_t> next(n, UINT32_MAX);
@@ -294,7 +331,10 @@ holes_to_fill(size_t n, const EdgeTable &et, const std::vector<uint32_t> &res,
         break;
       }
     }
-    if (!ok || v != v0 || loop.size() < 3 || loop.size() > max_loop)
+    if (!ok || v != v0 || loop.size() < 3 || max_loop == 0)
+      continue;
+    const bool slit = loop.size() >= kMinOpenLoop && is_slit(xyz, loop);
+    if (loop.size() > max_loop && !slit)
       continue;
     // A loop of at least kMinOpenLoop edges, most of whose samples failed
     // the ratio test (their Voronoi cells open sideways), is where the
@@ -302,7 +342,7 @@ holes_to_fill(size_t n, const EdgeTable &et, const std::vector<uint32_t> &res,
     // samples that are boundary samples only for disagreeing poles (stray
     // samples, thin parts such as the bunny's ears) are closed like any
     // other hole.
-    if (!boundary.empty() && loop.size() >= kMinOpenLoop) {
+    if (!boundary.empty() && loop.size() >= kMinOpenLoop && !slit) {
       size_t opens = 0;
       for (uint32_t w : loop)
         opens += boundary[w] == kOpenSample;
@@ -407,7 +447,7 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
   const size_t unfilled = res.size() / 3;
   Neighbours nb(n, et);
   const std::vector<std::vector<uint32_t>> loops =
-      holes_to_fill(n, et, res, max_loop, boundary);
+      holes_to_fill(xyz, n, et, res, max_loop, boundary);
   PatchScratch scratch(n);
   for (const std::vector<uint32_t> &hole : loops) {
     const size_t before = res.size();

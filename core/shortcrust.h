@@ -162,8 +162,9 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    missing triangle stays small. 1: every such edge is sharp, exactly as
  *    in the paper; one missing triangle then erodes the whole surface.
  *  - max_hole_edges: holes whose boundary loop has at most this many edges
- *    are closed after extraction by a least-area triangulation of the loop;
- *    0 disables.
+ *    are closed after extraction by a least-area triangulation of the loop,
+ *    and so are slits, loops narrower than their edges are long, whatever
+ *    their length (docs/algorithm.md section 9); 0 disables both.
  *  - threads: threads of the reconstruction; 0 means one per core. With
  *    several tiles, the tiles run on them; one triangulation runs on one
  *    thread (CGAL's parallel triangulation measured no faster: README,
@@ -240,7 +241,8 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "prune every edge with a single candidate, as in the paper")               \
   X(max_hole_edges, int, INT, 100, 0, 100000, SC_RANGE_CLOSED,                 \
     "in [0, 100000]", OPTION, 0, "max-hole", "N",                              \
-    "close holes of at most N edges, 0 = never")                               \
+    "close holes of at most N edges, and narrow slits of any length, "         \
+    "0 = never")                                                               \
   X(threads, int, INT, 1, 0, 1024, SC_RANGE_CLOSED, "in [0, 1024]", LOCAL,     \
     'j', "threads", "N",                                                       \
     "threads for the tiles and the smoothing (a single triangulation "         \
