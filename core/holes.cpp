@@ -6,6 +6,10 @@
 
 #include "edges.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 namespace sc {
 namespace {
 
@@ -254,17 +258,10 @@ bool cut_loop(const double *xyz, std::vector<uint32_t> &loop,
   return true;
 }
 
-// Whether a loop (vertex numbers in order) is a slit: narrower than
-// kSlitWidth of its edges, its width taken as twice its vector area over
-// its length (the width of a long thin strip; the radius of a round
-// hole, so that a round hole of 8 edges or more is never a slit). Such a
-// strip of missing triangles is what the candidate tests leave along a
-// sharp edge or a crease, where the cells of the samples open sideways as
-// at the end of a surface; a hole in the surface itself, a scan's edge or
-// the gap between scans, is wide. (Measured: the loops that boundary mode
-// left open along the sharp edges and thin parts of closed models, 0.3 to
-// 2 of an edge, most under 1; the bunny scans' edges and holes, 4 to 38.)
-bool is_slit(const double *xyz, const std::vector<uint32_t> &loop) {
+// A loop's width (vertex numbers in order), in its edges' median length:
+// twice its vector area over its length, the width of a long thin strip,
+// the radius of a round hole.
+double loop_width(const double *xyz, const std::vector<uint32_t> &loop) {
   const size_t k = loop.size();
   const double *o = xyz + 3 * size_t(loop[0]);
   double area[3] = {0, 0, 0}, length = 0;
@@ -281,19 +278,30 @@ bool is_slit(const double *xyz, const std::vector<uint32_t> &loop) {
     length += edge[i];
   }
   std::nth_element(edge.begin(), edge.begin() + k / 2, edge.end());
-  // Twice the vector area, |area| / 2, over the length.
-  const double width = std::sqrt(dot3(area, area)) / length;
-  return length > 0 && width <= kSlitWidth * edge[k / 2];
+  const double unit = length * edge[k / 2];
+  return unit > 0 ? std::sqrt(dot3(area, area)) / unit
+                  : std::numeric_limits<double>::infinity();
 }
 
-// The loops of the surface's holes that are to be filled, shortest first:
-// each a loop of at most max_loop edges (vertex numbers in order; the hole
-// runs along it) and not where the surface ends (see below), or a slit of
-// any length (is_slit()) where max_loop is not 0.
-std::vector<std::vector<uint32_t>>
-holes_to_fill(const double *xyz, size_t n, const EdgeTable &et,
-              const std::vector<uint32_t> &res, size_t max_loop,
-              const std::vector<uint8_t> &boundary) {
+// Whether a loop (vertex numbers in order) is a slit: narrower than
+// kSlitWidth of its edges (loop_width(); a round hole of 8 edges or more
+// is never that narrow). Such a
+// strip of missing triangles is what the candidate tests leave along a
+// sharp edge or a crease, where the cells of the samples open sideways as
+// at the end of a surface; a hole in the surface itself, a scan's edge or
+// the gap between scans, is wide. (Measured: the loops that boundary mode
+// left open along the sharp edges and thin parts of closed models, 0.3 to
+// 2 of an edge, most under 1; the bunny scans' edges and holes, 4 to 38.)
+bool is_slit(const double *xyz, const std::vector<uint32_t> &loop) {
+  return loop_width(xyz, loop) <= kSlitWidth;
+}
+
+// Calls take(loop, ok) for each boundary loop of the surface res (vertex
+// numbers in order; the hole runs along it): ok is false for a loop that
+// passes a vertex where two boundary edges leave, or does not close.
+template <class Take>
+void for_each_loop(size_t n, const EdgeTable &et,
+                   const std::vector<uint32_t> &res, Take &&take) {
   // The hole runs against the orientation of the triangle on each boundary
   // edge: a triangle with x -> y leaves the hole edge y -> x.
   std::vector<uint32_t> next(n, UINT32_MAX);
@@ -313,7 +321,6 @@ holes_to_fill(const double *xyz, size_t n, const EdgeTable &et,
     }
   }
   std::vector<uint32_t> loop;
-  std::vector<std::vector<uint32_t>> loops;
   std::vector<uint8_t> seen(n, 0);
   for (uint32_t v0 = 0; v0 < n; ++v0) {
     if (next[v0] == UINT32_MAX || seen[v0])
@@ -331,11 +338,25 @@ holes_to_fill(const double *xyz, size_t n, const EdgeTable &et,
         break;
       }
     }
-    if (!ok || v != v0 || loop.size() < 3 || max_loop == 0)
-      continue;
+    take(loop, ok && v == v0);
+  }
+}
+
+// The loops of the surface's holes that are to be filled, shortest first:
+// each a loop of at most max_loop edges (vertex numbers in order; the hole
+// runs along it) and not where the surface ends (see below), or a slit of
+// any length (is_slit()) where max_loop is not 0.
+std::vector<std::vector<uint32_t>>
+holes_to_fill(const double *xyz, size_t n, const EdgeTable &et,
+              const std::vector<uint32_t> &res, size_t max_loop,
+              const std::vector<uint8_t> &boundary) {
+  std::vector<std::vector<uint32_t>> loops;
+  for_each_loop(n, et, res, [&](const std::vector<uint32_t> &loop, bool ok) {
+    if (!ok || loop.size() < 3 || max_loop == 0)
+      return;
     const bool slit = loop.size() >= kMinOpenLoop && is_slit(xyz, loop);
     if (loop.size() > max_loop && !slit)
-      continue;
+      return;
     // A loop of at least kMinOpenLoop edges, most of whose samples failed
     // the ratio test (their Voronoi cells open sideways), is where the
     // surface ends, not a hole left by a missing triangle. Loops through
@@ -347,15 +368,15 @@ holes_to_fill(const double *xyz, size_t n, const EdgeTable &et,
       for (uint32_t w : loop)
         opens += boundary[w] == kOpenSample;
       if (2 * opens >= loop.size())
-        continue;
+        return;
     }
     // A three-edge loop around a lone triangle would be closed by a second
     // copy of that triangle.
     if (loop.size() == 3 &&
         is_triangle_of(et, res, loop[0], loop[1], loop[2]))
-      continue;
+      return;
     loops.push_back(loop);
-  }
+  });
   // Shortest first: when the work runs out, the many small holes are
   // closed and a few long ones stay open, not the other way round.
   std::stable_sort(loops.begin(), loops.end(),
@@ -460,6 +481,21 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &res,
   // The patches' triangles join the caller's table.
   if (!own)
     table->append(n, res, unfilled, progress);
+}
+
+double widest_loop(const double *xyz, size_t n,
+                   const std::vector<uint32_t> &tris, Progress &progress) {
+  if (tris.empty())
+    return 0;
+  EdgeTable et;
+  et.build(xyz, n, tris, progress, false);
+  double widest = 0;
+  for_each_loop(n, et, tris, [&](const std::vector<uint32_t> &loop, bool ok) {
+    widest = std::max(widest, ok && loop.size() >= 3
+                                  ? loop_width(xyz, loop)
+                                  : std::numeric_limits<double>::infinity());
+  });
+  return widest;
 }
 
 } // namespace sc

@@ -322,6 +322,12 @@ void fill_holes(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                 size_t max_loop, const std::vector<uint8_t> &boundary,
                 Progress &progress, sc_diag_t &diag,
                 uint64_t max_work = UINT64_MAX, EdgeTable *table = nullptr);
+// The width of the widest boundary loop of tris, in the median length of
+// its edges (twice its vector area over its length: the radius of a round
+// hole, the width of a slit; section 9); 0 when tris is closed, infinity
+// when a loop passes a pinched vertex.
+double widest_loop(const double *xyz, size_t n,
+                   const std::vector<uint32_t> &tris, Progress &progress);
 
 // Noise (denoise.cpp; section 16).
 struct NoiseEstimate {
@@ -428,6 +434,8 @@ private:
   // Watertight mode: closes surf, by labelling the Delaunay cells or by
   // least-area patches; before the patches, cuts the handles that closed
   // round holes of the scan when `cut`.
+  bool auto_closes(const double *lxyz, size_t m, const Surface &surf,
+                   const sc_diag_t &diag, Progress &progress) const;
   void close_surface(const double *lxyz, size_t m, bool cut,
                      Progress &progress, Surface &surf, sc_diag_t &diag);
   void patch_surface(const double *lxyz, size_t m, bool cut, Progress &progress,

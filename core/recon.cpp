@@ -36,6 +36,9 @@ constexpr size_t kMinBubble = 8;
 // share of the samples are boundary samples.
 constexpr size_t kKeepForLabels = 65536;
 constexpr double kKeepBoundaryShare = 0.1;
+// Auto mode takes a sample for one of a closed surface where no loop is
+// left open wider than this many of its edges (section 11.6).
+constexpr double kClosedLoopWidth = 3;
 // Denoising (and auto mode) smooths the points when the estimated noise
 // is at least this many spacings (README, "Noise"; measured with
 // shortcrust-noise-table and on the shared closed models).
@@ -204,6 +207,25 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   // Every loop of the extracted surface was closed if the result is.
   diag.holes_filled = diag.closed ? loops : 0;
   diag.hole_triangles = diag.triangles > before ? diag.triangles - before : 0;
+}
+
+// Auto mode (section 11.6): whether to close surf as watertight mode does.
+// Where it is one closed piece, there is nothing to close (samples left
+// out are attached afterwards; bubbles were dropped). Otherwise the sample is
+// taken for one of a closed surface when every loop left open, once the small
+// holes and the slits are filled, is narrow: a strip or a few triangles the
+// candidate tests missed (the closed models measured: 2.1 edges wide at most),
+// where a surface ends, at a scan's edge or between views, is wide (the bunny
+// scans' edges and holes: 4 to 38). Pieces with no loop open (a thin part
+// broken off) are closed too: the closing keeps apart what the cells keep
+// apart.
+bool Recon::auto_closes(const double *lxyz, size_t m, const Surface &surf,
+                        const sc_diag_t &diag, Progress &progress) const {
+  if (params_.mode != SC_MODE_AUTO || surf.tris.empty())
+    return false;
+  if (diag.closed && diag.components == 1)
+    return false;
+  return widest_loop(lxyz, m, surf.tris, progress) <= kClosedLoopWidth;
 }
 
 // Watertight mode's least-area patches (sections 11.2 and 11.3) over the
@@ -643,8 +665,15 @@ sc_mesh_t *Recon::finish() {
                       false, progress, diag);
     diag.bubbles_dropped =
         closed_before - std::min(closed_before, diag.closed_components);
-    if (watertight)
+    if (watertight) {
       close_surface(lxyz.data(), m, scan_holes, progress, surf, diag);
+    } else if (auto_closes(lxyz.data(), m, surf, diag, progress)) {
+      // The holes that extraction filled count too.
+      const uint64_t holes = diag.holes_filled, added = diag.hole_triangles;
+      close_surface(lxyz.data(), m, false, progress, surf, diag);
+      diag.holes_filled += holes;
+      diag.hole_triangles += added;
+    }
     diag.samples_attached =
         attach_samples(lxyz.data(), m, surf, progress, diag);
   }

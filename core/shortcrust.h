@@ -72,8 +72,10 @@ const char *sc_err_name(int code);
  *    undersampling), the input is taken as closed, as in auto mode: the
  *    cocone test everywhere, and no handle cut.
  *  - AUTO: for input not known to be closed: the cocone test where the
- *    samples look like a closed surface, boundary mode where they do not
- *    (diag.path says which was taken). */
+ *    samples look like a closed surface, boundary mode where they do not;
+ *    and where what is left open is narrow (no loop wider than 3 of its
+ *    edges) or in pieces, closed as in WATERTIGHT (diag.path says which
+ *    was taken). */
 #define SC_MODE_MAP(X)                                                         \
   X(SHORTCRUST, 0, "shortcrust")                                               \
   X(COCONE, 1, "cocone")                                                       \
