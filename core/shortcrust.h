@@ -430,8 +430,8 @@ int sc_params_can_tile(const sc_params_t *p);
   X(seconds_total, double, , SECONDS, "seconds.total",                         \
     "wall time of the whole reconstruction, in seconds")                       \
   X(path, int, , PATH, "path",                                                 \
-    "the path taken: what auto mode chose, and how watertight mode closed "    \
-    "the surface (the SC_PATH_ values)")                                       \
+    "the path taken: what auto mode chose, and how watertight mode (or auto "  \
+    "mode) closed the surface (the SC_PATH_ values)")                          \
   X(boundary_samples, uint64_t, , COUNT, "boundary_samples",                   \
     "samples found not interior (0 in the shortcrust and cocone modes)")       \
   X(longest_loop, uint64_t, , COUNT, "longest_loop",                           \
