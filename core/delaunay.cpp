@@ -299,8 +299,9 @@ public:
       std::memcpy(&out.poles[3 * size_t(v->info().idx)], v->info().pole,
                   sizeof v->info().pole);
     // The triangulation is not needed any more: free it before pruning so
-    // that the peak memory is the triangulation's alone (watertight mode's
-    // labelling alone keeps it, where it would otherwise build it again).
+    // that the peak memory is the triangulation's alone (watertight mode
+    // keeps it for the labelling with --labels, and where enough samples
+    // are boundary samples that the labelling nearly always runs).
     if (!keep && keep_boundary_share > 0 &&
         double(diag.boundary_samples) >=
             keep_boundary_share * double(out.to_input.size()))

@@ -285,13 +285,13 @@ double loop_width(const double *xyz, const std::vector<uint32_t> &loop) {
 
 // Whether a loop (vertex numbers in order) is a slit: narrower than
 // kSlitWidth of its edges (loop_width(); a round hole of 8 edges or more
-// is never that narrow). Such a
-// strip of missing triangles is what the candidate tests leave along a
-// sharp edge or a crease, where the cells of the samples open sideways as
-// at the end of a surface; a hole in the surface itself, a scan's edge or
-// the gap between scans, is wide. (Measured: the loops that boundary mode
-// left open along the sharp edges and thin parts of closed models, 0.3 to
-// 2 of an edge, most under 1; the bunny scans' edges and holes, 4 to 38.)
+// is never that narrow). Such a strip of missing triangles is what the
+// candidate tests leave along a sharp edge or a crease, where the cells of
+// the samples open sideways as at the end of a surface; a hole in the
+// surface itself, a scan's edge or the gap between scans, is wide.
+// (Measured: the loops that boundary mode left open along the sharp edges
+// and thin parts of closed models, 0.3 to 2 of an edge, most under 1; the
+// bunny scans' edges and holes, 4 to 38.)
 bool is_slit(const double *xyz, const std::vector<uint32_t> &loop) {
   return loop_width(xyz, loop) <= kSlitWidth;
 }

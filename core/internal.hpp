@@ -431,11 +431,13 @@ private:
   // How far each tile holds the points beyond its region from the start.
   double tile_margin() const { return 3 * noise_.spacing; }
   void insert_range(const double *xyz, size_t first, size_t n);
+  // Auto mode: whether surf, extracted, is of a closed surface and is to be
+  // closed as in watertight mode.
+  bool auto_closes(const double *lxyz, size_t m, const Surface &surf,
+                   const sc_diag_t &diag, Progress &progress) const;
   // Watertight mode: closes surf, by labelling the Delaunay cells or by
   // least-area patches; before the patches, cuts the handles that closed
   // round holes of the scan when `cut`.
-  bool auto_closes(const double *lxyz, size_t m, const Surface &surf,
-                   const sc_diag_t &diag, Progress &progress) const;
   void close_surface(const double *lxyz, size_t m, bool cut,
                      Progress &progress, Surface &surf, sc_diag_t &diag);
   void patch_surface(const double *lxyz, size_t m, bool cut, Progress &progress,
