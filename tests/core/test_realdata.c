@@ -57,17 +57,7 @@ int main(int argc, char **argv) {
   printf("%s %s: %s; handles cut %llu\n", argv[1], argc == 4 ? argv[3] : "",
          scs_meshcheck_summary(&c, line, sizeof line),
          (unsigned long long)m->diag.handles_cut);
-  EXPECT(c.manifold);
-  EXPECT(c.closed);
-  EXPECT(c.oriented);
-  EXPECT_EQ(c.components, 1);
-  EXPECT_EQ(c.genus_total, genus);
-  EXPECT_GT(c.volume, 0);
-  /* A stray sample or two far from the surface may stay out. */
-  EXPECT_LE(c.samples_unused * 1000, pts.count);
-  EXPECT_EQ(m->diag.genus, genus);
-  EXPECT(m->diag.closed);
-  EXPECT_DIAG_COUNTS(m->diag, c);
+  EXPECT_CLOSED_PIECE(m->diag, c, genus, pts.count);
   /* Right, so shortcrust mode's check finds no doubt (docs/algorithm.md
    * section 6.5); the other modes make none. */
   EXPECT_EQ(m->diag.checked, p.mode == SC_MODE_SHORTCRUST);

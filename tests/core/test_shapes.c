@@ -61,15 +61,7 @@ int main(int argc, char **argv) {
   char line[512];
   printf("%s %zu %s: %s\n", argv[1], n, argv[4],
          scs_meshcheck_summary(&c, line, sizeof line));
-  EXPECT(c.manifold);
-  EXPECT(c.closed);
-  EXPECT(c.oriented);
-  EXPECT_EQ(c.components, 1);
-  EXPECT_EQ(c.genus_total, genus);
-  EXPECT_GT(c.volume, 0); /* oriented outward */
-  EXPECT_LE(c.samples_unused * 1000, n);
-  EXPECT(m->diag.closed);
-  EXPECT_DIAG_COUNTS(m->diag, c);
+  EXPECT_CLOSED_PIECE(m->diag, c, genus, n);
   scs_meshcheck_free(&c);
   sc_mesh_free(m);
   free(xyz);
