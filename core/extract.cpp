@@ -335,7 +335,7 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, EdgeTablePtr table,
              size_t max_hole, const std::vector<uint8_t> &boundary,
              Progress &progress, Surface &out, sc_diag_t &diag,
-             bool check_vertices) {
+             bool check_vertices, std::vector<uint32_t> *unfilled) {
   const size_t nt = cand.size() / 3;
   // Only the survivors of pruning take part.
   std::vector<uint32_t> live;
@@ -371,6 +371,8 @@ void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
   // triangles about each edge in angular order, which none of the passes
   // below depends on).
   et.keep_live(in, false);
+  if (unfilled)
+    *unfilled = res;
   if (max_hole >= 3)
     fill_holes(xyz, n, res, max_hole, boundary, progress, diag, UINT64_MAX,
                &et);

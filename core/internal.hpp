@@ -235,12 +235,14 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
 // samples marked in boundary are left open. The walk takes the flattest
 // continuation first (section 8).
 // `check_vertices` as in describe(): pass false only when an open surface
-// will be described again before it is output.
+// will be described again before it is output. `unfilled`, when given,
+// receives the triangles before the holes were filled.
 void extract(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
              const std::vector<uint8_t> &alive, EdgeTablePtr table,
              size_t max_hole, const std::vector<uint8_t> &boundary,
              Progress &progress, Surface &out, sc_diag_t &diag,
-             bool check_vertices = true);
+             bool check_vertices = true,
+             std::vector<uint32_t> *unfilled = nullptr);
 // The topology of a finished surface (section 10): components, boundary loops,
 // genus, manifold checks; closed components facing inward are flipped. Resets
 // and fills the output fields of diag (triangles, boundary, components ...).
@@ -431,6 +433,11 @@ private:
   // How far each tile holds the points beyond its region from the start.
   double tile_margin() const { return 3 * noise_.spacing; }
   void insert_range(const double *xyz, size_t first, size_t n);
+  // Auto mode: whether watertight mode's closing of surf, extracted with
+  // no hole filled, is one closed piece of lower genus than `genus`; then
+  // surf and diag take that closure.
+  bool auto_cuts_handles(const double *lxyz, size_t m, int64_t genus,
+                         Progress &progress, Surface &surf, sc_diag_t &diag);
   // Auto mode: whether surf, extracted, is of a closed surface and is to be
   // closed as in watertight mode.
   bool auto_closes(const double *lxyz, size_t m, const Surface &surf,

@@ -228,6 +228,27 @@ bool Recon::auto_closes(const double *lxyz, size_t m, const Surface &surf,
   return widest_loop(lxyz, m, surf.tris, progress) <= kClosedLoopWidth;
 }
 
+// Auto mode (section 11.6), where filling the small holes closed the
+// surface in one piece of the given genus: whether watertight mode's
+// closing of surf, the surface before those holes were filled, is one
+// closed piece of lower genus. Then surf and diag take that closure. A
+// thin part meeting the body at a sharp edge (a fin, a blade) is where
+// this happens: the candidates miss a strip along the joint, the walk
+// closes a handle round its end, and filling the small hole left keeps the
+// handle, where watertight mode cuts it first (or labels the cells).
+bool Recon::auto_cuts_handles(const double *lxyz, size_t m, int64_t genus,
+                              Progress &progress, Surface &surf,
+                              sc_diag_t &diag) {
+  sc_diag_t d = diag;
+  Surface s = surf;
+  close_surface(lxyz, m, true, progress, s, d);
+  if (!d.closed || d.components != 1 || d.genus >= genus)
+    return false;
+  surf = std::move(s);
+  diag = d;
+  return true;
+}
+
 // Watertight mode's least-area patches (sections 11.2 and 11.3) over the
 // open components of surf, after cutting the handles that closed round a
 // hole (with cut); the closed components stay as they are.
@@ -648,23 +669,33 @@ sc_mesh_t *Recon::finish() {
   // surface the scan missed: the small ones are filled as in the other
   // modes, and no handle is cut.
   const bool scan_holes = watertight && !f.boundary.empty();
+  // Auto mode, where it found boundary samples, keeps the surface as
+  // extracted too, before its small holes were filled: for
+  // auto_cuts_handles().
+  std::vector<uint32_t> unfilled;
+  const bool auto_unfilled =
+      params_.mode == SC_MODE_AUTO && !f.boundary.empty();
+  const sc_diag_t extracting = diag;
   // Watertight mode describes an open surface again once it is closed,
   // and checks its vertices then (fix_fans_in() leaves one fan at each).
   extract(lxyz.data(), m, f.tris, alive, std::move(table),
           scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary, progress,
-          surf, diag, !watertight);
+          surf, diag, !watertight, auto_unfilled ? &unfilled : nullptr);
   if (detects_boundary(params_.mode)) {
     // Real scans: overlapping layers leave bubbles, small closed components
     // between them, and samples the walk passed by. Drop the bubbles;
     // watertight mode closes the surface while every triangle is still a
     // Delaunay facet (the labelling needs that); then every sample near the
     // surface is inserted into it.
-    const uint64_t closed_before = diag.closed_components;
-    drop_small_closed(lxyz.data(), m, surf,
-                      std::max<size_t>(kMinBubble, surf.tris.size() / 3 / 1000),
-                      false, progress, diag);
-    diag.bubbles_dropped =
-        closed_before - std::min(closed_before, diag.closed_components);
+    auto drop_bubbles = [&](Surface &s, sc_diag_t &d) {
+      const uint64_t closed_before = d.closed_components;
+      drop_small_closed(lxyz.data(), m, s,
+                        std::max<size_t>(kMinBubble, s.tris.size() / 3 / 1000),
+                        false, progress, d);
+      d.bubbles_dropped =
+          closed_before - std::min(closed_before, d.closed_components);
+    };
+    drop_bubbles(surf, diag);
     if (watertight) {
       close_surface(lxyz.data(), m, scan_holes, progress, surf, diag);
     } else if (auto_closes(lxyz.data(), m, surf, diag, progress)) {
@@ -673,7 +704,20 @@ sc_mesh_t *Recon::finish() {
       close_surface(lxyz.data(), m, false, progress, surf, diag);
       diag.holes_filled += holes;
       diag.hole_triangles += added;
+    } else if (auto_unfilled && diag.closed && diag.components == 1 &&
+               diag.holes_filled > 0) {
+      Surface open;
+      sc_diag_t open_diag = extracting;
+      open_diag.walk_rejected = diag.walk_rejected;
+      describe(lxyz.data(), m, unfilled, progress, open, open_diag);
+      drop_bubbles(open, open_diag);
+      if (auto_cuts_handles(lxyz.data(), m, diag.genus, progress, open,
+                            open_diag)) {
+        surf = std::move(open);
+        diag = open_diag;
+      }
     }
+    unfilled = std::vector<uint32_t>();
     diag.samples_attached =
         attach_samples(lxyz.data(), m, surf, progress, diag);
   }
