@@ -9,6 +9,10 @@
 namespace sc {
 namespace {
 
+// Passes over the samples left out at most (see attach_samples()): on the
+// models measured the last sample came in by the third.
+constexpr int kAttachPasses = 8;
+
 // Closest point of triangle abc to p (Ericson, Real-Time Collision
 // Detection, 5.1.5), as barycentric weights.
 void closest_on_triangle(const double *p, const double *a, const double *b,
@@ -452,13 +456,27 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
   VertexGrid grid(xyz, n, used, cell);
   Attacher attacher(xyz, n, surf, stars, grid,
                     surf.pinched != 0 || diag.nonmanifold_edges != 0);
+  // In vertex-number order, then again over those left while the last
+  // pass attached some: a sample beyond the end of a thin part (a horn's
+  // tip, sampled more sparsely than it is thick) comes near enough only
+  // once the samples between it and the surface are in.
+  std::vector<uint32_t> left;
+  for (uint32_t s = 0; s < n; ++s)
+    if (!used[s])
+      left.push_back(s);
   size_t attached = 0;
-  for (uint32_t s = 0; s < n; ++s) {
-    progress.tick(s, n);
-    if (used[s] || !attacher.attach(s))
-      continue;
-    used[s] = 1;
-    ++attached;
+  for (int pass = 0; pass < kAttachPasses && !left.empty(); ++pass) {
+    size_t kept = 0;
+    for (size_t i = 0; i < left.size(); ++i) {
+      progress.tick(i, left.size());
+      if (!attacher.attach(left[i]))
+        left[kept++] = left[i];
+    }
+    const size_t got = left.size() - kept;
+    left.resize(kept);
+    attached += got;
+    if (got == 0)
+      break;
   }
   if (attached == 0)
     return 0;
