@@ -164,6 +164,17 @@ int scs_sample_boxes(const double *boxes, size_t nboxes, size_t n,
                      uint64_t seed, double *xyz);
 
 /*
+ * Writes n points (3n doubles) spread uniformly at random over the ntri
+ * triangles of a mesh (3 vertex indices each into the nv vertices, 3
+ * doubles each): other samplings of a model than its vertex set.
+ * Bit-identical on every machine, as above. Returns 0, SCS_EINVAL (an
+ * index out of range, no triangle, a mesh of no area, or a NULL array),
+ * or SCS_ENOMEM.
+ */
+int scs_sample_mesh(const double *vertices, size_t nv, const uint32_t *tri,
+                    size_t ntri, size_t n, uint64_t seed, double *xyz);
+
+/*
  * The boxes of a named shape for scs_sample_boxes(), for n samples, and
  * its genus (one component); returns how many boxes, or 0 for an unknown
  * name. Thin parts are two sample spacings thick.

@@ -9,15 +9,56 @@
  * adaptive (denser where the surface curves more). SURFACE may also be a
  * shape of boxes with sharp edges (cube, plate, fin, frame:
  * scs_box_shape()), sampled uniformly at random, without noise (SIGMA 0)
- * or density.
+ * or density. SURFACE may also be a triangle mesh file (.ply, .off, .obj,
+ * .stl: any name with a dot), sampled uniformly at random by area
+ * (scs_sample_mesh()), with noise of SIGMA times the mean spacing of N
+ * samples on its area, and no density.
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
+#include "shortcrust_files.h"
 #include "synth.h"
+
+/* Samples the mesh in path into xyz; 0, or 1 with a message. */
+static int sample_mesh_file(const char *path, size_t n, double sigma,
+                            uint64_t seed, double *xyz) {
+  scf_points_t v = {0};
+  uint32_t *tri = NULL;
+  size_t ntri = 0;
+  char msg[256];
+  if (scf_mesh_read(path, &v, &tri, &ntri, msg, sizeof msg) != 0) {
+    fprintf(stderr, "synthgen: %s\n", msg);
+    return 1;
+  }
+  int rc = scs_sample_mesh(v.xyz, v.count, tri, ntri, n, seed, xyz);
+  if (rc != 0) {
+    fprintf(stderr, "synthgen: %s: %s\n", path,
+            ntri == 0 ? "no triangles" : "a bad or empty mesh");
+  } else if (sigma != 0) {
+    double area = 0;
+    for (size_t t = 0; t < ntri; t++) {
+      const double *a = v.xyz + 3 * (size_t)tri[3 * t],
+                   *b = v.xyz + 3 * (size_t)tri[3 * t + 1],
+                   *c = v.xyz + 3 * (size_t)tri[3 * t + 2];
+      double u[3], w[3];
+      for (int k = 0; k < 3; k++)
+        u[k] = b[k] - a[k], w[k] = c[k] - a[k];
+      area += 0.5 * sqrt(pow(u[1] * w[2] - u[2] * w[1], 2) +
+                         pow(u[2] * w[0] - u[0] * w[2], 2) +
+                         pow(u[0] * w[1] - u[1] * w[0], 2));
+    }
+    scs_add_noise(xyz, n, sigma * sqrt(area / (double)n), seed + 1000);
+  }
+  free(tri);
+  scf_points_free(&v);
+  return rc != 0;
+}
 
 int main(int argc, char **argv) {
   if (argc != 6 && argc != 7) {
@@ -36,7 +77,15 @@ int main(int argc, char **argv) {
   int genus;
   const size_t nboxes = scs_box_shape(argv[1], n, boxes, &genus);
   int bad = n < 4 || !xyz;
-  if (!bad && nboxes > 0) /* no noise on those: their spacing is not kept */
+  const int mesh = nboxes == 0 && strchr(argv[1], '.') != NULL;
+  if (mesh) {
+    if (bad || argc == 7 || sample_mesh_file(argv[1], n, sigma, seed, xyz)) {
+      fprintf(stderr, "%s: bad mesh, count or density (meshes: none)\n",
+              argv[0]);
+      free(xyz);
+      return 1;
+    }
+  } else if (!bad && nboxes > 0) /* no noise: their spacing is not kept */
     bad = sigma != 0 || argc == 7 ||
           scs_sample_boxes(boxes, nboxes, n, seed, xyz) != 0;
   else if (!bad)
@@ -50,7 +99,7 @@ int main(int argc, char **argv) {
             argv[0]);
     return 1;
   }
-  if (nboxes == 0)
+  if (nboxes == 0 && !mesh)
     scs_add_noise(xyz, n, sigma * scs_surface_spacing((scs_surface_t)s, n),
                   seed + 1000);
   FILE *f = fopen(argv[5], "w");

@@ -177,7 +177,49 @@ static void test_names(void) {
   EXPECT_NEAR(scs_surface_spacing(SCS_SURF_SPHERE, 0), 0, 0);
 }
 
+/* Samples of a mesh: a square of side 1 (two triangles) beside a
+ * triangle of area 2 at z = 1. Every point lies on one of them, each gets
+ * its share by area, the same seed gives the same points, and bad meshes
+ * are refused. */
+static void test_mesh(void) {
+  const double v[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1,
+                      0, 0, 0, 1, 2, 0, 1, 0, 2, 1};
+  const uint32_t tri[] = {0, 1, 2, 0, 2, 3, 4, 5, 6};
+  enum { M = 30000 };
+  double *a = malloc(3 * M * sizeof *a), *b = malloc(3 * M * sizeof *b);
+  EXPECT(a != NULL && b != NULL);
+  if (!a || !b) {
+    free(a);
+    free(b);
+    return;
+  }
+  EXPECT_EQ(scs_sample_mesh(v, 7, tri, 3, M, 9, a), SCS_OK);
+  EXPECT_EQ(scs_sample_mesh(v, 7, tri, 3, M, 9, b), SCS_OK);
+  EXPECT_MSG(memcmp(a, b, 3 * M * sizeof *a) == 0, "same seed, other points");
+  size_t square = 0, off = 0;
+  for (size_t i = 0; i < M; i++) {
+    const double *p = a + 3 * i;
+    if (p[2] == 0)
+      square += p[0] >= 0 && p[0] <= 1 && p[1] >= 0 && p[1] <= 1 ? 1 : 0;
+    else if (!(fabs(p[2] - 1) <= 1e-12 && p[0] >= 0 && p[1] >= 0 &&
+               p[0] + p[1] <= 2 + 1e-12))
+      off++;
+  }
+  EXPECT_EQ(off, 0);
+  /* A third of the area: binomial, within 5 standard deviations. */
+  EXPECT_NEAR((double)square, M / 3.0, 5 * sqrt(M * (1 / 3.0) * (2 / 3.0)));
+  const uint32_t bad[] = {0, 1, 7};
+  EXPECT_EQ(scs_sample_mesh(v, 7, bad, 1, 10, 1, a), SCS_EINVAL);
+  EXPECT_EQ(scs_sample_mesh(v, 7, tri, 0, 10, 1, a), SCS_EINVAL);
+  const uint32_t flat[] = {0, 1, 1};
+  EXPECT_EQ(scs_sample_mesh(v, 7, flat, 1, 10, 1, a), SCS_EINVAL);
+  EXPECT_EQ(scs_sample_mesh(v, 7, tri, 3, 10, 1, NULL), SCS_EINVAL);
+  free(a);
+  free(b);
+}
+
 int main(void) {
+  test_mesh();
   test_on_surface();
   test_counts();
   test_proportions();
