@@ -6,6 +6,8 @@
 
 #include "edges.hpp"
 
+#include <unordered_map>
+
 namespace sc {
 namespace {
 
@@ -222,6 +224,62 @@ private:
   bool around_set_ = false;
 };
 
+// The triangles that the vertex grid cannot find: those whose box is more
+// than a grid cell across, such as the patches over holes, whose corners
+// may all lie beyond the 27 cells about a sample right above them. Each is
+// listed in every cell that its box, grown by a cell, meets.
+class LargeTriangles {
+public:
+  explicit LargeTriangles(double cell) : cell_(cell) {}
+  // Lists triangle t (corners v) if it is large.
+  void add(const double *xyz, const uint32_t *v, uint32_t t) {
+    int64_t lo[3], hi[3];
+    int64_t cells = 1;
+    bool large = false;
+    for (int k = 0; k < 3; ++k) {
+      double a = xyz[3 * size_t(v[0]) + k], b = a;
+      for (int j = 1; j < 3; ++j) {
+        a = std::min(a, xyz[3 * size_t(v[j]) + k]);
+        b = std::max(b, xyz[3 * size_t(v[j]) + k]);
+      }
+      large = large || b - a > cell_;
+      lo[k] = int64_t(std::floor(a / cell_)) - 1;
+      hi[k] = int64_t(std::floor(b / cell_)) + 1;
+      cells *= hi[k] - lo[k] + 1;
+    }
+    // (A sliver across the whole surface would take too many cells; the
+    // fallback of nearest() still finds it from its corners.)
+    if (!large || cells > kMaxCells)
+      return;
+    for (int64_t x = lo[0]; x <= hi[0]; ++x)
+      for (int64_t y = lo[1]; y <= hi[1]; ++y)
+        for (int64_t z = lo[2]; z <= hi[2]; ++z)
+          cells_[key(x, y, z)].push_back(t);
+  }
+  // The squared distance within which a sample takes a large triangle.
+  double reach2() const { return cell_ * cell_; }
+  // Calls visit(t) on each triangle listed in the cell of point p.
+  template <class Visit> void for_cell(const double *p, Visit &&visit) const {
+    if (cells_.empty())
+      return;
+    const auto it = cells_.find(key(int64_t(std::floor(p[0] / cell_)),
+                                    int64_t(std::floor(p[1] / cell_)),
+                                    int64_t(std::floor(p[2] / cell_))));
+    if (it != cells_.end())
+      for (uint32_t t : it->second)
+        visit(t);
+  }
+
+private:
+  static constexpr int64_t kMaxCells = 1 << 15;
+  static uint64_t key(int64_t x, int64_t y, int64_t z) {
+    return uint64_t(x * 73856093) ^ uint64_t(y * 19349663) ^
+           uint64_t(z * 83492791);
+  }
+  double cell_;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
+};
+
 // The nearest triangle found for a sample so far: its squared distance,
 // the barycentric weights of its closest point, and its number.
 struct Nearest {
@@ -237,9 +295,9 @@ struct Nearest {
 class Attacher {
 public:
   Attacher(const double *xyz, size_t n, Surface &surf, GrowingStars &stars,
-           VertexGrid &grid, bool recount)
-      : xyz_(xyz), surf_(surf), tris_(surf.tris), stars_(stars),
-        grid_(grid), vstamp_(n, UINT32_MAX), recount_(recount) {}
+           VertexGrid &grid, LargeTriangles &large, bool recount)
+      : xyz_(xyz), surf_(surf), tris_(surf.tris), stars_(stars), grid_(grid),
+        large_(large), vstamp_(n, UINT32_MAX), recount_(recount) {}
 
   // Splits the triangle nearest sample s at it, if there is one near
   // enough; returns whether there was.
@@ -271,8 +329,6 @@ private:
       if (d < near)
         near = d, nu = u;
     });
-    if (nu == UINT32_MAX)
-      return best;
     // Each triangle near a sample is looked at once, though it is in the
     // stars of three vertices.
     auto visit = [&](uint32_t t) {
@@ -281,16 +337,25 @@ private:
         consider(p, t, best);
       }
     };
-    vstamp_[nu] = s;
-    stars_.for_star(nu, [&](uint32_t t) {
-      const uint32_t *v = &tris_[3 * size_t(t)];
-      for (int k = 0; k < 3; ++k)
-        if (vstamp_[v[k]] != s) {
-          vstamp_[v[k]] = s;
-          stars_.for_star(v[k], visit);
-        }
-      visit(t);
-    });
+    if (nu != UINT32_MAX) {
+      vstamp_[nu] = s;
+      stars_.for_star(nu, [&](uint32_t t) {
+        const uint32_t *v = &tris_[3 * size_t(t)];
+        for (int k = 0; k < 3; ++k)
+          if (vstamp_[v[k]] != s) {
+            vstamp_[v[k]] = s;
+            stars_.for_star(v[k], visit);
+          }
+        visit(t);
+      });
+    }
+    // The large triangles about it, whose corners may all be far: within
+    // a grid cell of the sample (their longest edges would let a sample
+    // far off a patch over the unscanned side of a scan in).
+    // (Not stamped: the last resort below may take them on the usual
+    // terms.)
+    large_.for_cell(p,
+                    [&](uint32_t t) { consider(p, t, best, large_.reach2()); });
     // None near enough there (the sample is off the edge of the surface,
     // or nearer another layer of it than its own): every triangle with a
     // corner in those grid cells.
@@ -301,7 +366,8 @@ private:
 
   // Takes triangle t for best if point p is nearer to it, and nearer than
   // its longest edge.
-  void consider(const double *p, uint32_t t, Nearest &best) const {
+  void consider(const double *p, uint32_t t, Nearest &best,
+                double reach2 = std::numeric_limits<double>::infinity()) const {
     const uint32_t *v = &tris_[3 * size_t(t)];
     const double *a = xyz_ + 3 * size_t(v[0]), *b = xyz_ + 3 * size_t(v[1]),
                  *c = xyz_ + 3 * size_t(v[2]);
@@ -324,7 +390,7 @@ private:
       q[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
     double d = dist2(p, q);
     double longest = std::max(dist2(a, b), std::max(dist2(b, c), dist2(c, a)));
-    if (d < best.d && d <= longest) {
+    if (d < best.d && d <= longest && d <= reach2) {
       best.d = d, best.t = t;
       std::copy(w, w + 3, best.w);
     }
@@ -416,6 +482,7 @@ private:
     tris_.push_back(a), tris_.push_back(b), tris_.push_back(c);
     stars_.gain(a, t), stars_.gain(b, t), stars_.gain(c, t);
     surf_.component.push_back(surf_.component[bt]);
+    large_.add(xyz_, &tris_[3 * size_t(t)], t);
     return t;
   }
   // Three triangles for one, or four for two: one more vertex, three
@@ -430,6 +497,7 @@ private:
   std::vector<uint32_t> &tris_;
   GrowingStars &stars_;
   VertexGrid &grid_;
+  LargeTriangles &large_;
   std::vector<uint32_t> stamp_, vstamp_;
   bool recount_, loops_grew_ = false;
 };
@@ -454,7 +522,10 @@ size_t attach_samples(const double *xyz, size_t n, Surface &surf,
   if (!(cell > 0))
     return 0;
   VertexGrid grid(xyz, n, used, cell);
-  Attacher attacher(xyz, n, surf, stars, grid,
+  LargeTriangles large(cell);
+  for (size_t t = 0; t < nt; ++t)
+    large.add(xyz, &tris[3 * t], uint32_t(t));
+  Attacher attacher(xyz, n, surf, stars, grid, large,
                     surf.pinched != 0 || diag.nonmanifold_edges != 0);
   // In vertex-number order, then again over those left while the last
   // pass attached some: a sample beyond the end of a thin part (a horn's

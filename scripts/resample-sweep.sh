@@ -10,8 +10,9 @@
 # BUILD_DIR defaults to build, DATA_DIR to ../shared/data; every
 # NAME_gt_mesh.ply of DATA_DIR/cgal_meshes and DATA_DIR (closed meshes
 # only) is sampled with `synthgen MESH N 0 SEED` (scs_sample_mesh()).
-# MODES (default "watertight auto cocone"), SEEDS (default "1 2") and
-# SCALES (default "1 3") choose the runs. A run is right where the output
+# MODES (default "watertight auto cocone"; MODE:OPTION adds --OPTION, as in
+# watertight:patches), SEEDS (default "1 2") and SCALES (default "1 3")
+# choose the runs. A run is right where the output
 # is closed, of the mesh's components and genus, with at most one sample
 # in a thousand unused. Prints one row per model and sampling, the totals
 # per mode, and the runs that missed with what they gave.
@@ -64,7 +65,9 @@ for mesh in "$data"/cgal_meshes/*_gt_mesh.ply "$data"/*_gt_mesh.ply; do
       row="| $name, seed $seed | $n |"
       for mode in $modes; do
         rep="$work/r.json"
-        if ! "$sc" reconstruct "$work/p.xyz" -o "$work/o.ply" --mode "$mode" \
+        args=(--mode "${mode%%:*}")
+        [[ $mode == *:* ]] && args+=("--${mode#*:}")
+        if ! "$sc" reconstruct "$work/p.xyz" -o "$work/o.ply" "${args[@]}" \
           --report "$rep" -q 2>/dev/null; then
           row+=" failed |"
           misses+=" $name-$n-s$seed@$mode(failed)"

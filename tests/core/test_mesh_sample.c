@@ -1,0 +1,88 @@
+/*
+ * Another sampling of a model than its vertex set: points spread uniformly
+ * at random over a closed mesh (scs_sample_mesh()), reconstructed in the
+ * mode named, must give one closed, oriented 2-manifold of the mesh's
+ * genus (measured on the mesh itself) with every sample a vertex. The
+ * fandisk's sharp edges at 10 000 random points: the patches span the
+ * strips the candidates miss along them, and the samples over those
+ * patches must be attached however far the patches' corners lie.
+ *
+ *   test_core_mesh_sample MESH.ply N SEED MODE [patches]
+ *
+ * Copyright (C) 2026 the shortcrust authors.
+ * SPDX-License-Identifier: GPL-3.0-or-later
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "diag.h"
+#include "shortcrust.h"
+#include "shortcrust_files.h"
+#include "synth.h"
+
+int main(int argc, char **argv) {
+  if (argc != 5 && argc != 6) {
+    fprintf(stderr, "usage: %s MESH.ply N SEED MODE [patches]\n", argv[0]);
+    return 2;
+  }
+  const size_t n = strtoul(argv[2], NULL, 10);
+  const uint64_t seed = strtoull(argv[3], NULL, 10);
+  sc_params_t p;
+  sc_params_init(&p);
+  p.mode = SC_MODE_COUNT_;
+  for (int k = 0; k < SC_MODE_COUNT_; ++k)
+    if (strcmp(argv[4], sc_mode_name(k)) == 0)
+      p.mode = (sc_mode_t)k;
+  if (p.mode == SC_MODE_COUNT_ || n < 100 ||
+      (argc == 6 && strcmp(argv[5], "patches") != 0)) {
+    fprintf(stderr, "unknown mode or option, or too few points\n");
+    return 2;
+  }
+  p.watertight_patches = argc == 6;
+  scf_points_t mesh = {0};
+  uint32_t *tri = NULL;
+  size_t ntri = 0;
+  char msg[512];
+  EXPECT_EQ(scf_mesh_read(argv[1], &mesh, &tri, &ntri, msg, sizeof msg), 0);
+  double *xyz = malloc(3 * n * sizeof *xyz);
+  EXPECT(xyz != NULL && ntri > 0);
+  if (!xyz || ntri == 0) {
+    fprintf(stderr, "%s\n", msg);
+    free(xyz);
+    free(tri);
+    scf_points_free(&mesh);
+    return sct_finish("core_mesh_sample");
+  }
+  // The mesh's own topology is the answer.
+  scs_meshcheck_t truth;
+  EXPECT_EQ(scs_meshcheck(mesh.count, mesh.xyz, tri, ntri, NULL, &truth), 0);
+  EXPECT(truth.closed && truth.components == 1);
+  const int genus = (int)truth.genus_total;
+  EXPECT_EQ(scs_sample_mesh(mesh.xyz, mesh.count, tri, ntri, n, seed, xyz), 0);
+  sc_mesh_t *m = NULL;
+  const int rc = sc_reconstruct(xyz, n, &p, &m, msg, sizeof msg);
+  EXPECT_EQ(rc, 0);
+  if (rc == 0) {
+    scs_meshcheck_t c;
+    EXPECT_EQ(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
+              0);
+    char line[512];
+    printf("%s, %zu random points, %s%s: %s; %llu attached\n", argv[1], n,
+           argv[4], argc == 6 ? " --patches" : "",
+           scs_meshcheck_summary(&c, line, sizeof line),
+           (unsigned long long)m->diag.samples_attached);
+    EXPECT_CLOSED_PIECE(m->diag, c, genus, n);
+    EXPECT_EQ(m->diag.samples_unused, 0);
+    EXPECT_EQ(c.samples_unused, 0);
+    scs_meshcheck_free(&c);
+    sc_mesh_free(m);
+  } else {
+    fprintf(stderr, "%s\n", msg);
+  }
+  scs_meshcheck_free(&truth);
+  free(xyz);
+  free(tri);
+  scf_points_free(&mesh);
+  return sct_finish("core_mesh_sample");
+}
