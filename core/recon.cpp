@@ -171,6 +171,14 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   const bool patches_first = !labels_only && params_.watertight_patches != 0;
   if (!labels_only)
     patch();
+  // The components of s but the pockets under a hundredth of it, which go
+  // below: they do not count.
+  auto pieces = [](const Surface &s) {
+    uint64_t k = 0;
+    for (const Surface::Part &p : s.parts)
+      k += uint64_t(100 * p.faces) >= s.tris.size() / 3;
+    return k;
+  };
   // The labelling is tried where the patches' closure shows a defect: open,
   // in pieces, samples left out, or a handle that had to be cut. Where the
   // patches give one closed piece (pockets aside) with no handle cut and
@@ -178,18 +186,38 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   // project's own target), it is not (section 11.5).
   auto doubtful = [&] {
     const Closure c(diag);
-    // Pockets under a hundredth of the surface go below: they do not count.
-    uint64_t pieces = 0;
-    for (const Surface::Part &p : surf.parts)
-      pieces += uint64_t(100 * p.faces) >= surf.tris.size() / 3;
-    return !c.ok || c.loops > 0 || pieces != 1 || diag.handles_cut > 0 ||
+    return !c.ok || c.loops > 0 || pieces(surf) != 1 || diag.handles_cut > 0 ||
            1000 * c.unused > m;
   };
   const bool labelling =
       labels_only || (patches_first ? !Closure(diag).ok : doubtful());
   diag.labelled = labelling;
+  // Where the labels' closure, in no more pieces, has more handles than
+  // the extracted surface had before the patches (their genus and the
+  // handles they cut), the labelling made them: tunnels along sharp edges,
+  // where the candidates miss strips that the patches span, or bridges
+  // between close parts. The patches' closure is kept then if, with the
+  // samples near each attached (attach_samples(), on copies), it leaves
+  // out no more of them than the labels' does or than one in a thousand.
+  // (Before attaching, the patches leave out the samples over the strips;
+  // where they cut true handles, which the labels keep, the labels' genus
+  // is not above theirs and their cuts. Where the extraction misses true
+  // holes that the labels find, as on the cheese, they are lost: section
+  // 11.5.)
+  auto made_handles = [&] {
+    const Closure p(diag), l(da);
+    if (!p.ok || !l.ok || p.loops != l.loops || pieces(surf) > pieces(a) ||
+        l.genus <= p.genus + int64_t(diag.handles_cut))
+      return false;
+    Surface sp = surf, sl = a;
+    sc_diag_t dp = diag, dl = da;
+    attach_samples(lxyz, m, sp, progress, dp);
+    attach_samples(lxyz, m, sl, progress, dl);
+    return dp.samples_unused <= std::max<uint64_t>(dl.samples_unused, m / 1000);
+  };
   if (labelling && label()) {
-    if (labels_only || !Closure(diag).better_than(Closure(da)))
+    if (labels_only ||
+        (!Closure(diag).better_than(Closure(da)) && !made_handles()))
       take_labels();
   } else if (labels_only) {
     patch(); // no cell came out inside
