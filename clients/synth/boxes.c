@@ -57,15 +57,7 @@ int scs_sample_boxes(const double *boxes, size_t nboxes, size_t n,
       free(cum); /* the union has (almost) no surface left */
       return SCS_EINVAL;
     }
-    const double t = scs_rng_uniform(&rng) * total;
-    size_t lo = 0, hi = 6 * nboxes - 1;
-    while (lo < hi) {
-      const size_t mid = (lo + hi) / 2;
-      if (cum[mid] > t)
-        hi = mid;
-      else
-        lo = mid + 1;
-    }
+    const size_t lo = scs_rng_pick(&rng, cum, 6 * nboxes);
     const double *b = boxes + 6 * (lo / 6);
     const int f = (int)(lo % 6), a = f / 2, side = f % 2;
     double p[3];

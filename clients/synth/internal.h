@@ -23,6 +23,14 @@ int scs_radix_sort(uint64_t *keys, uint32_t *vals, size_t n, int key_bits,
 /* Number of bits needed to hold x (0 for 0). */
 int scs_bits(uint64_t x);
 
+/*
+ * A random pick by weight: cum holds the k running sums of the weights
+ * (ascending, cum[k - 1] their total); draws one uniform number from rng
+ * and returns the first index whose running sum exceeds it times the
+ * total.
+ */
+size_t scs_rng_pick(scs_rng_t *rng, const double *cum, size_t k);
+
 /* One area-uniform random point of surface s (any component). */
 void scs_surface_point(scs_surface_t s, scs_rng_t *rng, double p[3]);
 

@@ -20,6 +20,16 @@ static double twice_area(const double *a, const double *b, const double *c) {
   return sqrt(x * x + y * y + z * z);
 }
 
+double scs_mesh_area(const double *vertices, const uint32_t *tri, size_t ntri) {
+  double area = 0;
+  for (size_t t = 0; t < ntri; t++) {
+    const uint32_t *v = tri + 3 * t;
+    area += twice_area(vertices + 3 * (size_t)v[0], vertices + 3 * (size_t)v[1],
+                       vertices + 3 * (size_t)v[2]);
+  }
+  return area / 2;
+}
+
 int scs_sample_mesh(const double *vertices, size_t nv, const uint32_t *tri,
                     size_t ntri, size_t n, uint64_t seed, double *xyz) {
   if (!vertices || !tri || ntri == 0 || (n > 0 && !xyz))
@@ -47,16 +57,7 @@ int scs_sample_mesh(const double *vertices, size_t nv, const uint32_t *tri,
   for (size_t i = 0; i < n; i++) {
     /* A triangle by area, then a point uniform in it (the square root
      * spreads the first weight so that area, not the corner, is uniform). */
-    const double r = scs_rng_uniform(&rng) * total;
-    size_t lo = 0, hi = ntri - 1;
-    while (lo < hi) {
-      const size_t mid = (lo + hi) / 2;
-      if (cum[mid] > r)
-        hi = mid;
-      else
-        lo = mid + 1;
-    }
-    const uint32_t *v = tri + 3 * lo;
+    const uint32_t *v = tri + 3 * scs_rng_pick(&rng, cum, ntri);
     const double *a = vertices + 3 * (size_t)v[0],
                  *b = vertices + 3 * (size_t)v[1],
                  *c = vertices + 3 * (size_t)v[2];

@@ -7,8 +7,8 @@
  */
 #include <math.h>
 
+#include "internal.h"
 #include "shortcrust.h"
-#include "synth.h"
 
 static uint64_t splitmix64(uint64_t *x) {
   uint64_t z = (*x += 0x9e3779b97f4a7c15ull);
@@ -54,4 +54,17 @@ void scs_add_noise(double *xyz, size_t n, double sigma, uint64_t seed) {
   scs_rng_seed(&rng, seed);
   for (size_t i = 0; i < 3 * n; ++i)
     xyz[i] += sigma * scs_rng_gauss(&rng);
+}
+
+size_t scs_rng_pick(scs_rng_t *rng, const double *cum, size_t k) {
+  const double t = scs_rng_uniform(rng) * cum[k - 1];
+  size_t lo = 0, hi = k - 1;
+  while (lo < hi) {
+    const size_t mid = (lo + hi) / 2;
+    if (cum[mid] > t)
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return lo;
 }

@@ -174,6 +174,9 @@ int scs_sample_boxes(const double *boxes, size_t nboxes, size_t n,
 int scs_sample_mesh(const double *vertices, size_t nv, const uint32_t *tri,
                     size_t ntri, size_t n, uint64_t seed, double *xyz);
 
+/* The area of the ntri triangles of a mesh, as for scs_sample_mesh(). */
+double scs_mesh_area(const double *vertices, const uint32_t *tri, size_t ntri);
+
 /*
  * The boxes of a named shape for scs_sample_boxes(), for n samples, and
  * its genus (one component); returns how many boxes, or 0 for an unknown

@@ -41,18 +41,7 @@ static int sample_mesh_file(const char *path, size_t n, double sigma,
     fprintf(stderr, "synthgen: %s: %s\n", path,
             ntri == 0 ? "no triangles" : "a bad or empty mesh");
   } else if (sigma != 0) {
-    double area = 0;
-    for (size_t t = 0; t < ntri; t++) {
-      const double *a = v.xyz + 3 * (size_t)tri[3 * t],
-                   *b = v.xyz + 3 * (size_t)tri[3 * t + 1],
-                   *c = v.xyz + 3 * (size_t)tri[3 * t + 2];
-      double u[3], w[3];
-      for (int k = 0; k < 3; k++)
-        u[k] = b[k] - a[k], w[k] = c[k] - a[k];
-      area += 0.5 * sqrt(pow(u[1] * w[2] - u[2] * w[1], 2) +
-                         pow(u[2] * w[0] - u[0] * w[2], 2) +
-                         pow(u[0] * w[1] - u[1] * w[0], 2));
-    }
+    const double area = scs_mesh_area(v.xyz, tri, ntri);
     scs_add_noise(xyz, n, sigma * sqrt(area / (double)n), seed + 1000);
   }
   free(tri);

@@ -193,6 +193,7 @@ static void test_mesh(void) {
     free(b);
     return;
   }
+  EXPECT_NEAR(scs_mesh_area(v, tri, 3), 3, 1e-12);
   EXPECT_EQ(scs_sample_mesh(v, 7, tri, 3, M, 9, a), SCS_OK);
   EXPECT_EQ(scs_sample_mesh(v, 7, tri, 3, M, 9, b), SCS_OK);
   EXPECT_MSG(memcmp(a, b, 3 * M * sizeof *a) == 0, "same seed, other points");
