@@ -9,7 +9,12 @@
 #ifndef SC_TESTS_CORE_DIAG_H
 #define SC_TESTS_CORE_DIAG_H
 
+#include <stdio.h>
+#include <string.h>
+
 #include "sct_assert.h"
+#include "shortcrust.h"
+#include "synth.h"
 
 /* d is an sc_diag_t, c an scs_meshcheck_t. */
 #define EXPECT_DIAG_COUNTS(d, c)                                               \
@@ -41,5 +46,46 @@
     EXPECT((d).closed);                                                        \
     EXPECT_DIAG_COUNTS((d), (c));                                              \
   } while (0)
+
+/* The mode of that name (sc_mode_name()), or SC_MODE_COUNT_. */
+static inline sc_mode_t sct_mode_from_name(const char *name) {
+  for (int k = 0; k < SC_MODE_COUNT_; ++k)
+    if (strcmp(name, sc_mode_name(k)) == 0)
+      return (sc_mode_t)k;
+  return SC_MODE_COUNT_;
+}
+
+/* Reconstructs the n samples xyz with p and checks the mesh as
+ * EXPECT_CLOSED_PIECE does, and that every sample is a vertex when
+ * every_sample; prints `what` with the mesh checker's summary. Returns the
+ * mesh for further checks (the caller frees it), or NULL where the
+ * reconstruction failed. */
+static inline sc_mesh_t *sct_expect_closed(const double *xyz, size_t n,
+                                           const sc_params_t *p, int genus,
+                                           int every_sample, const char *what) {
+  char msg[512];
+  sc_mesh_t *m = NULL;
+  const int rc = sc_reconstruct(xyz, n, p, &m, msg, sizeof msg);
+  EXPECT_EQ(rc, 0);
+  if (rc != 0) {
+    fprintf(stderr, "%s: %s\n", what, msg);
+    return NULL;
+  }
+  scs_meshcheck_t c;
+  EXPECT_EQ(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
+            0);
+  char line[512];
+  printf("%s: %s; %llu attached, %llu handles cut\n", what,
+         scs_meshcheck_summary(&c, line, sizeof line),
+         (unsigned long long)m->diag.samples_attached,
+         (unsigned long long)m->diag.handles_cut);
+  EXPECT_CLOSED_PIECE(m->diag, c, genus, n);
+  if (every_sample) {
+    EXPECT_EQ(m->diag.samples_unused, 0);
+    EXPECT_EQ(c.samples_unused, 0);
+  }
+  scs_meshcheck_free(&c);
+  return m;
+}
 
 #endif /* SC_TESTS_CORE_DIAG_H */

@@ -31,10 +31,7 @@ int main(int argc, char **argv) {
   }
   sc_params_t p;
   sc_params_init(&p);
-  p.mode = SC_MODE_COUNT_;
-  for (int k = 0; k < SC_MODE_COUNT_; ++k)
-    if (strcmp(argv[1], sc_mode_name(k)) == 0)
-      p.mode = (sc_mode_t)k;
+  p.mode = sct_mode_from_name(argv[1]);
   const size_t n = strtoul(argv[2], NULL, 10);
   const uint64_t seed = strtoull(argv[3], NULL, 10);
   double boxes[6 * SCS_MAX_BOXES];
@@ -67,28 +64,10 @@ int main(int argc, char **argv) {
       chain[3 * k + 1] = 0.5;
       chain[3 * k + 2] = 1 + out * step;
     }
-    char msg[512];
-    sc_mesh_t *m = NULL;
-    const int rc = sc_reconstruct(xyz, total, &p, &m, msg, sizeof msg);
-    EXPECT_EQ(rc, 0);
-    if (rc != 0) {
-      fprintf(stderr, "%s\n", msg);
-      continue;
-    }
-    scs_meshcheck_t c;
-    EXPECT_EQ(
-        scs_meshcheck(total, xyz, m->triangles, m->triangle_count, NULL, &c),
-        0);
-    char line[512];
-    printf("%s, %s: %s; %llu attached\n", argv[1], kOrders[order],
-           scs_meshcheck_summary(&c, line, sizeof line),
-           (unsigned long long)m->diag.samples_attached);
-    EXPECT_CLOSED_PIECE(m->diag, c, genus, total);
     // Every sample, the chain's too.
-    EXPECT_EQ(m->diag.samples_unused, 0);
-    EXPECT_EQ(c.samples_unused, 0);
-    scs_meshcheck_free(&c);
-    sc_mesh_free(m);
+    char what[128];
+    snprintf(what, sizeof what, "%s, %s", argv[1], kOrders[order]);
+    sc_mesh_free(sct_expect_closed(xyz, total, &p, genus, 1, what));
   }
   free(cube);
   free(xyz);

@@ -30,10 +30,7 @@ int main(int argc, char **argv) {
   const uint64_t seed = strtoull(argv[3], NULL, 10);
   sc_params_t p;
   sc_params_init(&p);
-  p.mode = SC_MODE_COUNT_;
-  for (int k = 0; k < SC_MODE_COUNT_; ++k)
-    if (strcmp(argv[4], sc_mode_name(k)) == 0)
-      p.mode = (sc_mode_t)k;
+  p.mode = sct_mode_from_name(argv[4]);
   if (p.mode == SC_MODE_COUNT_ || n < 100 ||
       (argc == 6 && strcmp(argv[5], "patches") != 0)) {
     fprintf(stderr, "unknown mode or option, or too few points\n");
@@ -60,26 +57,10 @@ int main(int argc, char **argv) {
   EXPECT(truth.closed && truth.components == 1);
   const int genus = (int)truth.genus_total;
   EXPECT_EQ(scs_sample_mesh(mesh.xyz, mesh.count, tri, ntri, n, seed, xyz), 0);
-  sc_mesh_t *m = NULL;
-  const int rc = sc_reconstruct(xyz, n, &p, &m, msg, sizeof msg);
-  EXPECT_EQ(rc, 0);
-  if (rc == 0) {
-    scs_meshcheck_t c;
-    EXPECT_EQ(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
-              0);
-    char line[512];
-    printf("%s, %zu random points, %s%s: %s; %llu attached\n", argv[1], n,
-           argv[4], argc == 6 ? " --patches" : "",
-           scs_meshcheck_summary(&c, line, sizeof line),
-           (unsigned long long)m->diag.samples_attached);
-    EXPECT_CLOSED_PIECE(m->diag, c, genus, n);
-    EXPECT_EQ(m->diag.samples_unused, 0);
-    EXPECT_EQ(c.samples_unused, 0);
-    scs_meshcheck_free(&c);
-    sc_mesh_free(m);
-  } else {
-    fprintf(stderr, "%s\n", msg);
-  }
+  char what[512];
+  snprintf(what, sizeof what, "%s, %zu random points, %s%s", argv[1], n,
+           argv[4], argc == 6 ? " --patches" : "");
+  sc_mesh_free(sct_expect_closed(xyz, n, &p, genus, 1, what));
   scs_meshcheck_free(&truth);
   free(xyz);
   free(tri);

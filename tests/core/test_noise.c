@@ -20,16 +20,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "diag.h"
 #include "sct_assert.h"
 #include "shortcrust.h"
 #include "synth.h"
-
-static int mode_from_name(const char *s) {
-  for (int m = 0; m < SC_MODE_COUNT_; ++m)
-    if (strcmp(s, sc_mode_name(m)) == 0)
-      return m;
-  return -1;
-}
 
 /* The checks of a closed surface of the right topology. */
 static void check_surface(const char *what, const scs_surface_info_t *info,
@@ -63,9 +57,9 @@ int main(int argc, char **argv) {
   const int surf = scs_surface_from_name(argv[1]);
   const size_t n = strtoul(argv[2], NULL, 10);
   const double sigma = atof(argv[3]);
-  const int mode = mode_from_name(argv[4]);
+  const int mode = sct_mode_from_name(argv[4]);
   const uint64_t seed = argc > 5 ? strtoull(argv[5], NULL, 10) : 1;
-  if (surf < 0 || n < 100 || !(sigma >= 0) || mode < 0) {
+  if (surf < 0 || n < 100 || !(sigma >= 0) || mode == SC_MODE_COUNT_) {
     fprintf(stderr, "bad arguments\n");
     return 2;
   }

@@ -26,10 +26,7 @@ int main(int argc, char **argv) {
   sc_params_t p;
   sc_params_init(&p);
   if (argc == 4) {
-    p.mode = SC_MODE_COUNT_;
-    for (int k = 0; k < SC_MODE_COUNT_; ++k)
-      if (strcmp(argv[3], sc_mode_name(k)) == 0)
-        p.mode = (sc_mode_t)k;
+    p.mode = sct_mode_from_name(argv[3]);
     if (p.mode == SC_MODE_COUNT_) {
       fprintf(stderr, "unknown mode '%s'\n", argv[3]);
       return 2;
@@ -42,27 +39,17 @@ int main(int argc, char **argv) {
     fprintf(stderr, "FAIL: %s\n", msg);
     return 1;
   }
-  sc_mesh_t *m = NULL;
-  int rc = sc_reconstruct(pts.xyz, pts.count, &p, &m, msg, sizeof msg);
-  EXPECT_EQ(rc, 0);
-  if (rc != 0) {
-    fprintf(stderr, "%s\n", msg);
+  char what[512];
+  snprintf(what, sizeof what, "%s %s", argv[1], argc == 4 ? argv[3] : "");
+  sc_mesh_t *m = sct_expect_closed(pts.xyz, pts.count, &p, genus, 0, what);
+  if (!m) {
+    scf_points_free(&pts);
     return sct_finish("core_realdata");
   }
-  scs_meshcheck_t c;
-  EXPECT_EQ(scs_meshcheck(pts.count, pts.xyz, m->triangles, m->triangle_count,
-                          NULL, &c),
-            0);
-  char line[512];
-  printf("%s %s: %s; handles cut %llu\n", argv[1], argc == 4 ? argv[3] : "",
-         scs_meshcheck_summary(&c, line, sizeof line),
-         (unsigned long long)m->diag.handles_cut);
-  EXPECT_CLOSED_PIECE(m->diag, c, genus, pts.count);
   /* Right, so shortcrust mode's check finds no doubt (docs/algorithm.md
    * section 6.5); the other modes make none. */
   EXPECT_EQ(m->diag.checked, p.mode == SC_MODE_SHORTCRUST);
   EXPECT_EQ(m->diag.topology_doubt, 0);
-  scs_meshcheck_free(&c);
   sc_mesh_free(m);
   scf_points_free(&pts);
   return sct_finish("core_realdata");

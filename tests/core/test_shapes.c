@@ -30,10 +30,7 @@ int main(int argc, char **argv) {
   const uint64_t seed = strtoull(argv[3], NULL, 10);
   sc_params_t p;
   sc_params_init(&p);
-  p.mode = SC_MODE_COUNT_;
-  for (int k = 0; k < SC_MODE_COUNT_; ++k)
-    if (strcmp(argv[4], sc_mode_name(k)) == 0)
-      p.mode = (sc_mode_t)k;
+  p.mode = sct_mode_from_name(argv[4]);
   double boxes[6 * SCS_MAX_BOXES];
   int genus;
   const size_t nboxes = scs_box_shape(argv[1], n, boxes, &genus);
@@ -46,24 +43,9 @@ int main(int argc, char **argv) {
   if (!xyz)
     return sct_finish("core_shapes");
   EXPECT_EQ(scs_sample_boxes(boxes, nboxes, n, seed, xyz), 0);
-  char msg[512];
-  sc_mesh_t *m = NULL;
-  const int rc = sc_reconstruct(xyz, n, &p, &m, msg, sizeof msg);
-  EXPECT_EQ(rc, 0);
-  if (rc != 0) {
-    fprintf(stderr, "%s\n", msg);
-    free(xyz);
-    return sct_finish("core_shapes");
-  }
-  scs_meshcheck_t c;
-  EXPECT_EQ(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
-            0);
-  char line[512];
-  printf("%s %zu %s: %s\n", argv[1], n, argv[4],
-         scs_meshcheck_summary(&c, line, sizeof line));
-  EXPECT_CLOSED_PIECE(m->diag, c, genus, n);
-  scs_meshcheck_free(&c);
-  sc_mesh_free(m);
+  char what[128];
+  snprintf(what, sizeof what, "%s %zu %s", argv[1], n, argv[4]);
+  sc_mesh_free(sct_expect_closed(xyz, n, &p, genus, 0, what));
   free(xyz);
   return sct_finish("core_shapes");
 }

@@ -14,24 +14,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "diag.h"
 #include "sct_assert.h"
 #include "shortcrust.h"
 #include "synth.h"
 #include "testsupport.h"
-
-static int mode_from_name(const char *s) {
-  if (strcmp(s, "shortcrust") == 0)
-    return SC_MODE_SHORTCRUST;
-  if (strcmp(s, "cocone") == 0)
-    return SC_MODE_COCONE;
-  if (strcmp(s, "boundary") == 0)
-    return SC_MODE_BOUNDARY;
-  if (strcmp(s, "watertight") == 0)
-    return SC_MODE_WATERTIGHT;
-  if (strcmp(s, "auto") == 0)
-    return SC_MODE_AUTO;
-  return -1;
-}
 
 int main(int argc, char **argv) {
   if (argc < 5) {
@@ -40,10 +27,10 @@ int main(int argc, char **argv) {
   }
   int surf = scs_surface_from_name(argv[1]);
   int dens = scs_density_from_name(argv[2]);
-  int mode = mode_from_name(argv[3]);
+  int mode = sct_mode_from_name(argv[3]);
   size_t n = strtoul(argv[4], NULL, 10);
   uint64_t seed = argc > 5 ? strtoull(argv[5], NULL, 10) : 1;
-  if (surf < 0 || dens < 0 || mode < 0 || n < 4) {
+  if (surf < 0 || dens < 0 || mode == SC_MODE_COUNT_ || n < 4) {
     fprintf(stderr, "bad arguments\n");
     return 2;
   }
