@@ -56,10 +56,14 @@ public:
     report(0.0);
   }
   void report(double fraction) {
+    last_ = fraction;
     if (fn_ && fn_(user_, stage_, fraction))
       throw Error(SC_ECANCELLED, "cancelled during stage " +
                                      std::string(sc_stage_name(stage_)));
   }
+  // While waiting for other threads: reports the last fraction again, so
+  // that a cancel is taken.
+  void poll() { report(last_); }
   // For loops: report every `every` iterations (a power of two); i of
   // about n, never more than the whole.
   void tick(size_t i, size_t n, size_t every = 1u << 15) {
@@ -71,6 +75,7 @@ private:
   sc_progress_fn fn_;
   void *user_;
   sc_stage_t stage_ = SC_STAGE_INPUT;
+  double last_ = 0;
 };
 
 // Shortcrust mode's check (docs/algorithm.md section 6.5), from the same
@@ -405,6 +410,29 @@ void merge_tiles(const double *xyz, size_t n, const sc_mesh_t *const *tiles,
 // least size fit.
 size_t memory_tiles(size_t n, unsigned threads, double limit);
 
+// Watertight mode on more than one thread: the labelling of the Delaunay
+// cells (section 11.4) reads nothing of the extracted surface, so it runs
+// on a thread of its own while the surface is pruned, extracted and
+// patched (section 11.5). Over the triangulation that filter() kept, or
+// over a triangulation of the m points lxyz (in vertex order) built first;
+// lxyz must outlive the task. Destroying it stops and joins the thread.
+class LabelTask {
+public:
+  LabelTask(std::unique_ptr<Triangulator> dt, const double *lxyz, size_t m);
+  ~LabelTask();
+  LabelTask(const LabelTask &) = delete;
+  LabelTask &operator=(const LabelTask &) = delete;
+  // Waits for the labelling, reporting progress (and so taking a cancel)
+  // meanwhile; then as Triangulator::close(): the boundary of the inside
+  // cells in tris and diag's cells_relabelled, false when no cell is
+  // inside. Rethrows what the thread threw.
+  bool take(std::vector<uint32_t> &tris, Progress &progress, sc_diag_t &diag);
+
+private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
 // One reconstruction, fed all at once or in chunks.
 class Recon {
 public:
@@ -464,6 +492,9 @@ private:
   size_t tile_count() const;
   // The threads asked for, one per core for 0.
   unsigned thread_count() const;
+  // Watertight mode: whether the labelling may run beside the extraction
+  // (LabelTask): on more than one thread, unless the patches come first.
+  bool labels_beside() const;
   void prepare(Progress &progress);
   sc_params_t params_;
   std::vector<double> own_;
@@ -481,8 +512,10 @@ private:
   Smoothing smoothing_;
   double seconds_denoise_ = 0;
   std::unique_ptr<Triangulator> dt_;
-  // Watertight mode: the triangulation filter() kept for the labelling.
+  // Watertight mode: the triangulation filter() kept for the labelling,
+  // or the labelling under way on a thread of its own.
   std::unique_ptr<Triangulator> kept_;
+  std::unique_ptr<LabelTask> labelling_;
   double seconds_[SC_STAGE_COUNT] = {};
   const sc_mesh_t *const *merge_ = nullptr;
   size_t merge_count_ = 0;

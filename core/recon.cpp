@@ -7,12 +7,16 @@
 #include "internal.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <climits>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <limits>
+#include <mutex>
 #include <new>
 #include <thread>
 
@@ -95,6 +99,74 @@ struct Closure {
 
 } // namespace
 
+struct LabelTask::State {
+  std::unique_ptr<Triangulator> dt;
+  std::vector<uint32_t> tris;
+  sc_diag_t diag{};
+  bool inside = false, done = false;
+  std::exception_ptr error;
+  std::atomic<int> stop{0};
+  std::mutex mu;
+  std::condition_variable cv;
+  std::thread thread;
+};
+
+LabelTask::LabelTask(std::unique_ptr<Triangulator> dt, const double *lxyz,
+                     size_t m)
+    : state_(new State) {
+  State &st = *state_;
+  st.dt = std::move(dt);
+  st.thread = std::thread([&st, lxyz, m] {
+    // A stop makes the next progress tick throw.
+    Progress mine(
+        [](void *u, sc_stage_t, double) {
+          return static_cast<std::atomic<int> *>(u)->load();
+        },
+        &st.stop);
+    try {
+      if (!st.dt) {
+        st.dt = make_triangulator();
+        st.dt->insert(lxyz, 0, m, mine);
+      }
+      st.inside = st.dt->close(st.tris, mine, st.diag);
+    } catch (...) {
+      st.error = std::current_exception();
+    }
+    st.dt.reset();
+    {
+      std::lock_guard<std::mutex> lock(st.mu);
+      st.done = true;
+    }
+    st.cv.notify_all();
+  });
+}
+
+LabelTask::~LabelTask() {
+  state_->stop = 1;
+  state_->thread.join();
+}
+
+bool LabelTask::take(std::vector<uint32_t> &tris, Progress &progress,
+                     sc_diag_t &diag) {
+  State &st = *state_;
+  {
+    std::unique_lock<std::mutex> lock(st.mu);
+    while (!st.done) {
+      st.cv.wait_for(lock, std::chrono::milliseconds(50));
+      lock.unlock();
+      progress.poll(); // a cancel stops the thread (the destructor)
+      lock.lock();
+    }
+  }
+  if (st.error)
+    std::rethrow_exception(st.error);
+  if (!st.inside)
+    return false;
+  tris.swap(st.tris);
+  diag.cells_relabelled += st.diag.cells_relabelled;
+  return true;
+}
+
 // Watertight mode, after extraction (docs/algorithm.md sections 11.2 to
 // 11.5): closes surf, in two ways where the first leaves doubt, and keeps
 // the better (see Closure):
@@ -130,14 +202,22 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     // The triangulation that filter() kept (--labels); or, where it went
     // after the candidates (by default), built again over the same points,
     // numbered as the surface's vertices are.
-    std::unique_ptr<Triangulator> dt = std::move(kept_);
-    if (!dt) {
-      dt = make_triangulator();
-      dt->insert(lxyz, 0, m, progress);
-    }
+    // Or the labelling already under way beside the extraction.
     std::vector<uint32_t> labelled;
-    if (!dt->close(labelled, progress, da))
-      return false;
+    if (labelling_) {
+      const bool inside = labelling_->take(labelled, progress, da);
+      labelling_.reset();
+      if (!inside)
+        return false;
+    } else {
+      std::unique_ptr<Triangulator> dt = std::move(kept_);
+      if (!dt) {
+        dt = make_triangulator();
+        dt->insert(lxyz, 0, m, progress);
+      }
+      if (!dt->close(labelled, progress, da))
+        return false;
+    }
     canonical_order(labelled, true);
     describe(lxyz, m, labelled, progress, a, da);
     if (da.nonmanifold_edges || da.nonmanifold_vertices) {
@@ -223,6 +303,7 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     patch(); // no cell came out inside
   }
   kept_.reset();
+  labelling_.reset(); // not needed: the patches' closure stands
   // Pockets: closing may leave small closed components inside the main one
   // (the inside of a bubble, a cap that closed on itself). Those under a
   // hundredth of the surface go; their samples may be attached later.
@@ -348,6 +429,11 @@ size_t Recon::tile_count() const {
       k = std::max(k, need);
   }
   return k >= 2 ? k : 0;
+}
+
+bool Recon::labels_beside() const {
+  return params_.mode == SC_MODE_WATERTIGHT && !params_.watertight_patches &&
+         thread_count() > 1;
 }
 
 unsigned Recon::thread_count() const {
@@ -651,11 +737,20 @@ sc_mesh_t *Recon::finish() {
     // boundary samples, it is kept: the patches left doubt on every input
     // measured that had so many (anchor_dense, bull, dino, fandisk, hand,
     // man, rotor_small, triceratops; none that the patches close had more
-    // than 8%), and building it again cost as much as the first time.
+    // than 8%), and building it again cost as much as the first time. Auto
+    // mode closes as watertight mode does where the sample looks closed
+    // (section 11.6), and keeps it by the same rule; it goes once the
+    // surface is extracted, closed or not.
     const bool closing = params_.mode == SC_MODE_WATERTIGHT;
     dt_->keep = closing && params_.watertight_labels;
     dt_->keep_boundary_share =
-        closing && n_ <= kKeepForLabels ? kKeepBoundaryShare : 0;
+        (closing || params_.mode == SC_MODE_AUTO) && n_ <= kKeepForLabels
+            ? kKeepBoundaryShare
+            : 0;
+    // On more threads, wherever a boundary sample is found: the labelling
+    // then runs beside the extraction (LabelTask), on it.
+    if (labels_beside() && !params_.watertight_labels)
+      dt_->keep_boundary_share = std::numeric_limits<double>::min();
     dt_->filter(work, n_, params_, progress, f, diag, seconds_);
     if (dt_->keep)
       kept_ = std::move(dt_);
@@ -681,6 +776,15 @@ sc_mesh_t *Recon::finish() {
   for (size_t k = 0; k < m; ++k)
     std::memcpy(&lxyz[3 * k], work + 3 * size_t(f.to_input[k]),
                 3 * sizeof(double));
+  // The labelling, where it is likely to be needed (boundary samples were
+  // found, or --labels), starts now on a thread of its own; it reads lxyz,
+  // and stops before lxyz goes, whatever happens.
+  struct StopLabelling {
+    std::unique_ptr<LabelTask> &task;
+    ~StopLabelling() { task.reset(); }
+  } stop_labelling{labelling_};
+  if (labels_beside() && (params_.watertight_labels || !f.boundary.empty()))
+    labelling_.reset(new LabelTask(std::move(kept_), lxyz.data(), m));
   const sc_diag_t before_prune = diag;
   std::vector<uint8_t> alive;
   EdgeTablePtr table;
@@ -746,6 +850,7 @@ sc_mesh_t *Recon::finish() {
       }
     }
     unfilled = std::vector<uint32_t>();
+    kept_.reset();
     diag.samples_attached =
         attach_samples(lxyz.data(), m, surf, progress, diag);
   }

@@ -171,7 +171,9 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    several tiles, the tiles run on them; one triangulation runs on one
  *    thread (CGAL's parallel triangulation measured no faster: README,
  *    "Benchmark"). Denoising's smoothing runs on them too, with the same
- *    result on any number.
+ *    result on any number, and so does watertight mode's labelling of the
+ *    Delaunay cells, beside the extraction, where boundary samples are
+ *    found (docs/algorithm.md section 11.5).
  *  - tiles (every mode; watertight mode with watertight_labels runs one
  *    triangulation): the points are split into this many tiles whose
  *    triangulations are certified against each other, so that the mesh is
@@ -247,8 +249,8 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "0 = never")                                                               \
   X(threads, int, INT, 1, 0, 1024, SC_RANGE_CLOSED, "in [0, 1024]", LOCAL,     \
     'j', "threads", "N",                                                       \
-    "threads for the tiles and the smoothing (a single triangulation "         \
-    "runs on one), 0 = one per core")                                          \
+    "threads for the tiles, the smoothing and watertight mode's labelling "    \
+    "(a single triangulation runs on one), 0 = one per core")                  \
   X(tiles, int, INT, 1, 0, 4096, SC_RANGE_CLOSED, "in [0, 4096]", LOCAL, 0,    \
     "tiles", "N",                                                              \
     "split the points into N tiles triangulated apart, on the threads; the "   \

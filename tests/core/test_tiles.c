@@ -11,8 +11,10 @@
  * job's tiles are refused.
  *
  *   test_core_tiles [SCAN.ply ...]
- *   test_core_tiles --quick      (a small torus on two threads, and the
- *                                 cancel: for the ThreadSanitizer build)
+ *   test_core_tiles --quick [CLOSED.ply ...]
+ *                  (a small torus on two threads, watertight mode's
+ *                   labelling beside the extraction on CLOSED, and the
+ *                   cancels: for the ThreadSanitizer build)
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -206,6 +208,64 @@ static int cancel_in_delaunay(void *user, sc_stage_t stage, double fraction) {
   return 0;
 }
 
+static int cancel_in_extract(void *user, sc_stage_t stage, double fraction) {
+  (void)fraction;
+  int *calls = user;
+  if (stage == SC_STAGE_EXTRACT && ++*calls > 1)
+    return 1;
+  return 0;
+}
+
+/* Watertight mode on two threads labels the cells beside the extraction
+ * (docs/algorithm.md section 11.5): the mesh and diagnostics of one
+ * thread, by default and with the labelling alone; and a cancel while it
+ * runs stops it. */
+static void labelling_beside(const char *path) {
+  scf_points_t pts;
+  char msg[256] = "";
+  if (scf_points_read(path, &pts, msg, sizeof msg) != 0) {
+    EXPECT_FAIL("%s: %s", path, msg);
+    return;
+  }
+  for (int labels = 0; labels < 2; ++labels) {
+    sc_params_t p;
+    sc_params_init(&p);
+    p.mode = SC_MODE_WATERTIGHT;
+    p.watertight_labels = labels;
+    p.threads = 1;
+    sc_mesh_t *one = run_with(path, pts.xyz, pts.count, &p);
+    p.threads = 2;
+    sc_mesh_t *two = run_with(path, pts.xyz, pts.count, &p);
+    char tag[300];
+    snprintf(tag, sizeof tag, "%s, watertight%s on 2 threads", path,
+             labels ? " (labels)" : "");
+    if (one && two && same_output(tag, one, two)) {
+      EXPECT(two->diag.labelled && two->diag.boundary_samples > 0);
+      EXPECT_EQ(one->diag.path, two->diag.path);
+      EXPECT_EQ(one->diag.cells_relabelled, two->diag.cells_relabelled);
+      EXPECT_EQ(one->diag.samples_attached, two->diag.samples_attached);
+      printf("ok: %s: %zu triangles, genus %lld, %llu cells relabelled\n", tag,
+             two->triangle_count, (long long)two->diag.genus,
+             (unsigned long long)two->diag.cells_relabelled);
+    }
+    sc_mesh_free(one);
+    sc_mesh_free(two);
+  }
+  sc_params_t p;
+  sc_params_init(&p);
+  p.mode = SC_MODE_WATERTIGHT;
+  p.threads = 2;
+  int calls = 0;
+  p.progress = cancel_in_extract;
+  p.progress_user = &calls;
+  sc_mesh_t *mesh = NULL;
+  EXPECT_EQ(sc_reconstruct(pts.xyz, pts.count, &p, &mesh, msg, sizeof msg),
+            SC_ECANCELLED);
+  EXPECT_NULL(mesh);
+  printf("ok: cancel beside the labelling: %s\n", msg);
+  scf_points_free(&pts);
+}
+
 int main(int argc, char **argv) {
   const int quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
   /* A torus, well spaced, with a few exact duplicates. */
@@ -248,6 +308,8 @@ int main(int argc, char **argv) {
     }
     sc_mesh_free(one);
     sc_mesh_free(t);
+    for (int a = 2; a < argc; ++a)
+      labelling_beside(argv[a]);
     goto cancel;
   }
   check("torus", xyz, n + dups, 0);
