@@ -76,6 +76,7 @@ public:
   // was, when no cell is inside.
   bool label_and_close(std::vector<uint32_t> &tris, Progress &progress,
                        sc_diag_t &diag) {
+    progress_ = &progress;
     const size_t m = dt_.number_of_vertices();
     vh_.assign(m, Vh());
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
@@ -129,6 +130,7 @@ private:
     // crossing()).
     node_.resize(n);
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c) {
+      poll(c->info().w.local);
       Node &d = node_[c->info().w.local];
       for (int f = 0; f < 4; ++f)
         d.nbr[f] = c->neighbor(f)->info().w.local;
@@ -180,8 +182,9 @@ private:
       }
     }
 
-    size_t done = 0;
+    size_t done = 0, pops = 0;
     while (!queue.empty()) {
+      poll(pops++);
       const Entry e = queue.top();
       queue.pop();
       // The cells are visited all over the triangulation: ask for the next
@@ -245,6 +248,7 @@ private:
     kmin_.resize(n);
     uint32_t i = 0;
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c, ++i) {
+      poll(i);
       c->info().w.local = i;
       cells_[i] = c;
       uint32_t k = UINT32_MAX;
@@ -260,6 +264,14 @@ private:
     return kmin_[i] != kmin_[j] ? kmin_[i] < kmin_[j]
                                 : cell_key(cells_[i]) < cell_key(cells_[j]);
   }
+
+  // Every so many steps of a long loop, whether the work is to stop (a
+  // cancel, or the labelling beside the extraction not needed: LabelTask).
+  void poll(size_t step) {
+    if ((step & 0x1FFF) == 0)
+      progress_->poll();
+  }
+  Progress *progress_ = nullptr;
 
   // What weighing reads of a cell, together.
   struct Node {
@@ -317,6 +329,7 @@ private:
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
       const uint32_t i = c->info().w.local;
       const Node &b = node_[i];
+      poll(i);
       for (int j = 0; j < 4; ++j) {
         Poles &p = poles[c->vertex(j)->info().idx];
         const float d2 = dist2(c->vertex(j)->point(), b.o);
@@ -342,6 +355,7 @@ private:
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
       const uint32_t i = c->info().w.local;
       const float *o = node_[i].o;
+      poll(i);
       for (int j = 0; j < 4; ++j) {
         Poles &p = poles[c->vertex(j)->info().idx];
         const Point &s = c->vertex(j)->point();
@@ -507,6 +521,7 @@ private:
         }
       unresolved.clear();
       while (!work.empty() && !gave_up) {
+        poll(steps);
         gave_up = ++steps > budget;
         Vh v = work.back();
         work.pop_back();
