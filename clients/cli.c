@@ -294,6 +294,9 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
             : r->params.memory_limit > 0 ? "it fits the memory limit"
             : r->params.tiles == 0 && r->params.threads == 1
                 ? "one tile per thread, and one thread"
+            : r->params.tiles == 0 && r->params.mode == SC_MODE_WATERTIGHT &&
+                    !r->params.watertight_patches
+                ? "watertight mode labels its cells beside the extraction"
             : d->tile_points_foreign
                 ? "the tiles' Delaunay balls reach far across each other "
                   "(as inside a closed surface's sample), so one "

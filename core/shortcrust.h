@@ -180,7 +180,10 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
  *    the one a single triangulation gives, triangle for triangle
  *    (docs/algorithm.md section 17). 1, the default, never tiles; 0 means
  *    one per thread, given up for one triangulation where the tiles would
- *    cost more (diag.tiles 0, diag.tile_points_foreign not: section 17.4).
+ *    cost more (diag.tiles 0, diag.tile_points_foreign not: section 17.4),
+ *    and none in watertight mode on more than one thread unless
+ *    watertight_patches (its labelling runs on the one triangulation,
+ *    beside the extraction: section 11.5).
  *  - boundary_rho (boundary, watertight and auto modes): a sample passes
  *    the ratio test when the farthest Voronoi vertex of its cell inside its
  *    cocone is at most boundary_rho times the distance to its negative
@@ -254,8 +257,8 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
   X(tiles, int, INT, 1, 0, 4096, SC_RANGE_CLOSED, "in [0, 4096]", LOCAL, 0,    \
     "tiles", "N",                                                              \
     "split the points into N tiles triangulated apart, on the threads; the "   \
-    "same mesh whatever N; 0 = one per thread, while tiles pay (not with "     \
-    "--labels)")                                                               \
+    "same mesh whatever N; 0 = one per thread, while tiles pay (in "           \
+    "watertight mode only with --patches)")                                    \
   X(memory_limit, double, BYTES, 0, 0, 1e300,                                  \
     SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "positive", LOCAL, 0,            \
     "memory-limit", "BYTES",                                                   \
