@@ -208,7 +208,7 @@ bool row(const char *file, const char *method, const char *path, size_t points,
 // closed models' methods and columns, and right[m] counts the models
 // method m got right (the advancing front last).
 int measure(const std::string &dir, const std::string &name, int repeat,
-            bool afsr, bool closed, int *right) {
+            int threads, bool afsr, bool closed, int *right) {
   // (Rounds: see main(). A file of a few hundred points takes a
   // millisecond, so small files get rounds until the yardstick has taken
   // kMinYardstick seconds.)
@@ -271,6 +271,7 @@ int measure(const std::string &dir, const std::string &name, int repeat,
       sc_params_init(&p);
       p.mode = methods[m].mode;
       p.denoise = methods[m].denoise;
+      p.threads = threads;
       sc_mesh_free(meshes[m]);
       meshes[m] = nullptr;
       cold_heap();
@@ -387,8 +388,8 @@ int main(int argc, char **argv) {
     bool help = argc >= 2 && (std::strcmp(argv[1], "--help") == 0 ||
                               std::strcmp(argv[1], "-h") == 0);
     std::fprintf(help ? stdout : stderr,
-                 "usage: %s [--closed] DATA_DIR [--repeat N] [--no-afsr] "
-                 "[FILE ...]\n\n"
+                 "usage: %s [--closed] DATA_DIR [--repeat N] [--threads N] "
+                 "[--no-afsr] [FILE ...]\n\n"
                  "Runs every mode (boundary and watertight also with --denoise)"
                  "\nand CGAL's advancing front on the point "
                  "files\nDATA_DIR/FILE.ply (default: the bunny scans, "
@@ -399,7 +400,9 @@ int main(int argc, char **argv) {
                  "has\ntaken 0.25 s in all), each round running the "
                  "construction and then\nevery mode, so that all see the "
                  "same load. The advancing front\nruns once; --no-afsr "
-                 "leaves it out (it takes minutes on the\nmerged scans).\n\n"
+                 "leaves it out (it takes minutes on the\nmerged scans). "
+                 "--threads N runs every mode on N threads\n(default 1); "
+                 "the construction always runs on one.\n\n"
                  "--closed: the closed models, FILE_points.ply beside their\n"
                  "FILE_gt_mesh.ply (default: every such pair in DATA_DIR),\n"
                  "in the modes for closed surfaces, each row with the\n"
@@ -416,13 +419,19 @@ int main(int argc, char **argv) {
   // as each mode's: the machines are shared, and one run can be slowed by
   // anything. A round runs the yardstick and then every mode, so that a
   // slow spell slows both sides of a ratio.
-  int repeat = 3;
+  int repeat = 3, threads = 1;
   bool afsr = true;
   for (int i = 2; i < argc; ++i) {
     if (std::strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
       repeat = std::atoi(argv[++i]);
       if (repeat < 1) {
         std::fprintf(stderr, "--repeat needs a count of at least 1\n");
+        return 2;
+      }
+    } else if (std::strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+      threads = std::atoi(argv[++i]);
+      if (threads < 1 || threads > 1024) {
+        std::fprintf(stderr, "--threads needs a count in [1, 1024]\n");
         return 2;
       }
     } else if (std::strcmp(argv[i], "--no-afsr") == 0) {
@@ -485,7 +494,7 @@ int main(int argc, char **argv) {
       return 1;
     }
     if (pid == 0) {
-      const int rc = measure(dir, name, repeat, afsr, closed, right);
+      const int rc = measure(dir, name, repeat, threads, afsr, closed, right);
       std::fflush(stdout);
       std::_Exit(rc);
     }
