@@ -200,20 +200,16 @@ static void check(const char *what, const double *xyz, size_t n,
   }
 }
 
-static int cancel_in_delaunay(void *user, sc_stage_t stage, double fraction) {
-  (void)fraction;
-  int *calls = user;
-  if (stage == SC_STAGE_DELAUNAY && ++*calls > 3)
-    return 1;
-  return 0;
-}
+/* A cancel once the progress has come `after` times in `stage`. */
+typedef struct {
+  sc_stage_t stage;
+  int after, calls;
+} cancel_at_t;
 
-static int cancel_in_extract(void *user, sc_stage_t stage, double fraction) {
+static int cancel_at(void *user, sc_stage_t stage, double fraction) {
   (void)fraction;
-  int *calls = user;
-  if (stage == SC_STAGE_EXTRACT && ++*calls > 1)
-    return 1;
-  return 0;
+  cancel_at_t *c = user;
+  return stage == c->stage && ++c->calls > c->after;
 }
 
 /* Watertight mode on two threads labels the cells beside the extraction
@@ -255,9 +251,9 @@ static void labelling_beside(const char *path) {
   sc_params_init(&p);
   p.mode = SC_MODE_WATERTIGHT;
   p.threads = 2;
-  int calls = 0;
-  p.progress = cancel_in_extract;
-  p.progress_user = &calls;
+  cancel_at_t at = {SC_STAGE_EXTRACT, 1, 0};
+  p.progress = cancel_at;
+  p.progress_user = &at;
   sc_mesh_t *mesh = NULL;
   EXPECT_EQ(sc_reconstruct(pts.xyz, pts.count, &p, &mesh, msg, sizeof msg),
             SC_ECANCELLED);
@@ -376,9 +372,9 @@ cancel : {
   sc_params_init(&p);
   p.tiles = 4;
   p.threads = 2;
-  int calls = 0;
-  p.progress = cancel_in_delaunay;
-  p.progress_user = &calls;
+  cancel_at_t at = {SC_STAGE_DELAUNAY, 3, 0};
+  p.progress = cancel_at;
+  p.progress_user = &at;
   sc_mesh_t *mesh = NULL;
   char msg[256] = "";
   EXPECT_EQ(sc_reconstruct(xyz, n, &p, &mesh, msg, sizeof msg), SC_ECANCELLED);
