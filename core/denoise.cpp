@@ -17,6 +17,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -97,6 +98,9 @@ struct KdTree {
 // shell until no closer point can be left outside.
 class Neighbours {
 public:
+  // At most this many neighbours a query.
+  static constexpr size_t kMaxK = 32;
+
   Neighbours(const double *xyz, size_t n) : xyz_(xyz), n_(n) {
     double lo[3], hi[3];
     for (int a = 0; a < 3; ++a)
@@ -108,7 +112,8 @@ public:
       }
     // A side that gives cells of a few points on a surface filling its
     // box (the volume's), a plane (the largest face's) or a curve (the
-    // length's), whichever the points spread over.
+    // length's), whichever the points spread over. (Cells 1.5 and 2 times
+    // as wide, for fewer shells, measured slower: more points looked at.)
     double e[3];
     for (int a = 0; a < 3; ++a) {
       e[a] = hi[a] - lo[a];
@@ -125,11 +130,13 @@ public:
       buckets <<= 1;
     mask_ = buckets - 1;
     start_.assign(buckets + 1, 0);
+    // Cell coordinates are at most the largest extent over the side,
+    // itself at least that extent over n: they fit 32 bits.
+    PrefaultVector<Cell> cells(n);
     PrefaultVector<uint32_t> bucket(n);
     for (size_t i = 0; i < n; ++i) {
-      int64_t c[3];
-      cell(&xyz[3 * i], c);
-      bucket[i] = uint32_t(hash(c));
+      cells[i] = cell(&xyz[3 * i]);
+      bucket[i] = uint32_t(hash(cells[i]));
       ++start_[bucket[i] + 1];
     }
     size_t most = 0;
@@ -137,28 +144,42 @@ public:
       most = std::max<size_t>(most, start_[b + 1]);
       start_[b + 1] += start_[b];
     }
-    order_.resize(n);
-    PrefaultVector<uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (size_t i = 0; i < n; ++i)
-      order_[fill[bucket[i]]++] = uint32_t(i);
     if (most > kCrowded) {
       tree_.reset(new KdTree(xyz, n));
-      start_.clear(), order_.clear();
+      start_.clear();
+      return;
+    }
+    order_.resize(n);
+    cells_.resize(n);
+    PrefaultVector<uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t o = fill[bucket[i]]++;
+      order_[o] = uint32_t(i);
+      cells_[o] = cells[i];
     }
   }
 
   // The k nearest points of point i (itself among them), nearest first,
   // into ids and their squared distances into d2; where fewer than k
-  // points exist, the rest repeat i at distance 0.
+  // points exist, the rest repeat i at distance 0. k is at most kMaxK.
   void nearest(size_t i, size_t k, uint32_t *ids, double *d2) const {
-    best_.clear();
-    const double *p = &xyz_[3 * i];
     if (tree_) {
       tree_->nearest(i, k, ids, d2);
       return;
     }
-    int64_t c[3];
-    cell(p, c);
+    Best best(k);
+    const double *p = &xyz_[3 * i];
+    const Cell c = cell(p);
+    // How far p lies inside its cell from each of the cell's faces:
+    // points beyond shell d lie at least d sides plus the least of these
+    // away.
+    double margin = HUGE_VAL;
+    for (int a = 0; a < 3; ++a) {
+      const double below = p[a] - (lo_[a] + double(c[a]) * side_);
+      margin = std::min(
+          {margin, std::max(0.0, below), std::max(0.0, side_ - below)});
+    }
+    margin = std::max(0.0, margin - 1e-9 * side_); // for rounding
     size_t looked = 0;
     for (int64_t d = 0;; ++d) {
       for (int64_t dx = -d; dx <= d; ++dx)
@@ -167,26 +188,30 @@ public:
           // Only the shell: all of z on its sides, the two ends inside.
           for (int64_t dz = -d; dz <= d;
                dz += side ? 1 : std::max<int64_t>(1, 2 * d)) {
-            const int64_t q[3] = {c[0] + dx, c[1] + dy, c[2] + dz};
-            scan(p, q, k);
+            const int64_t q[3] = {int64_t(c[0]) + dx, int64_t(c[1]) + dy,
+                                  int64_t(c[2]) + dz};
             ++looked;
+            // No point has a negative coordinate or one past 32 bits.
+            if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] > kCellMax ||
+                q[1] > kCellMax || q[2] > kCellMax)
+              continue;
+            scan(p, Cell{uint32_t(q[0]), uint32_t(q[1]), uint32_t(q[2])}, best);
           }
         }
-      // Points of cells beyond shell d lie farther than d sides away.
-      const double reach = double(d) * side_;
-      if (best_.size() == k && best_.back().first <= reach * reach)
+      const double reach = double(d) * side_ + margin;
+      if (best.full() && best.worst() <= reach * reach)
         break;
       if (looked > kMaxCells) { // an isolated point: look at all
-        best_.clear();
+        best = Best(k);
         for (size_t j = 0; j < n_; ++j)
-          offer(p, uint32_t(j), k);
+          best.offer(distance2(p, j), uint32_t(j));
         break;
       }
     }
     size_t j = 0;
-    for (; j < best_.size(); ++j) {
-      d2[j] = best_[j].first;
-      ids[j] = best_[j].second;
+    for (; j < best.size(); ++j) {
+      d2[j] = best.d2[j];
+      ids[j] = best.id[j];
     }
     for (; j < k; ++j) {
       ids[j] = uint32_t(i);
@@ -195,44 +220,62 @@ public:
   }
 
 private:
+  typedef std::array<uint32_t, 3> Cell;
+  static constexpr int64_t kCellMax = int64_t(UINT32_MAX);
   // Cells with more points than this in one bucket make the grid not pay
   // (a far outlier stretching the box, many copies of a point);
   // a query that has looked at this many cells looks at every point.
   static constexpr size_t kCrowded = 1024;
   static constexpr size_t kMaxCells = 8192;
 
-  void cell(const double *p, int64_t c[3]) const {
+  // The k nearest found so far, in (distance, index) order.
+  struct Best {
+    explicit Best(size_t k) : k_(k) {}
+    size_t size() const { return n_; }
+    bool full() const { return n_ == k_; }
+    double worst() const { return d2[n_ - 1]; }
+    void offer(double e, uint32_t j) {
+      if (n_ == k_ && !(e < d2[n_ - 1] || (e == d2[n_ - 1] && j < id[n_ - 1])))
+        return;
+      size_t at = n_ == k_ ? n_ - 1 : n_++;
+      for (; at > 0 && (e < d2[at - 1] || (e == d2[at - 1] && j < id[at - 1]));
+           --at) {
+        d2[at] = d2[at - 1];
+        id[at] = id[at - 1];
+      }
+      d2[at] = e;
+      id[at] = j;
+    }
+    double d2[kMaxK];
+    uint32_t id[kMaxK];
+
+  private:
+    size_t k_, n_ = 0;
+  };
+
+  Cell cell(const double *p) const {
+    Cell c;
     for (int a = 0; a < 3; ++a)
-      c[a] = int64_t(std::floor((p[a] - lo_[a]) / side_));
+      c[a] = uint32_t(std::floor((p[a] - lo_[a]) / side_));
+    return c;
   }
-  size_t hash(const int64_t c[3]) const {
+  size_t hash(const Cell &c) const {
     uint64_t h = uint64_t(c[0]) * 0x9E3779B97F4A7C15ull ^
                  uint64_t(c[1]) * 0xC2B2AE3D27D4EB4Full ^
                  uint64_t(c[2]) * 0x165667B19E3779F9ull;
     return size_t(h ^ (h >> 29)) & mask_;
   }
-  // The points of cell q, less those of other cells in the same bucket.
-  void scan(const double *p, const int64_t q[3], size_t k) const {
-    const size_t b = hash(q);
-    for (uint32_t o = start_[b]; o < start_[b + 1]; ++o) {
-      int64_t c[3];
-      cell(&xyz_[3 * size_t(order_[o])], c);
-      if (c[0] == q[0] && c[1] == q[1] && c[2] == q[2])
-        offer(p, order_[o], k);
-    }
-  }
-  // Keeps point j among the k nearest found so far, in (distance, index)
-  // order.
-  void offer(const double *p, uint32_t j, size_t k) const {
-    const double *y = &xyz_[3 * size_t(j)];
+  double distance2(const double *p, size_t j) const {
+    const double *y = &xyz_[3 * j];
     const double dx = y[0] - p[0], dy = y[1] - p[1], dz = y[2] - p[2];
-    const std::pair<double, uint32_t> e(dx * dx + dy * dy + dz * dz, j);
-    if (best_.size() == k) {
-      if (!(e < best_.back()))
-        return;
-      best_.pop_back();
-    }
-    best_.insert(std::upper_bound(best_.begin(), best_.end(), e), e);
+    return dx * dx + dy * dy + dz * dz;
+  }
+  // The points of cell q, less those of other cells in the same bucket.
+  void scan(const double *p, const Cell &q, Best &best) const {
+    const size_t b = hash(q);
+    for (uint32_t o = start_[b]; o < start_[b + 1]; ++o)
+      if (cells_[o][0] == q[0] && cells_[o][1] == q[1] && cells_[o][2] == q[2])
+        best.offer(distance2(p, order_[o]), order_[o]);
   }
 
   const double *xyz_;
@@ -241,8 +284,9 @@ private:
   size_t mask_;
   std::unique_ptr<KdTree> tree_;
   PrefaultVector<uint32_t> start_, order_;
-  mutable std::vector<std::pair<double, uint32_t>> best_;
+  PrefaultVector<Cell> cells_;
 };
+static_assert(kEstimateNeighbours <= Neighbours::kMaxK, "too many neighbours");
 
 // The weighted moments of points about a point p: sum w, sum w d and
 // sum w d d^T (d = point - p), from which the weighted least-squares plane
