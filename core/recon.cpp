@@ -788,7 +788,11 @@ sc_mesh_t *Recon::finish() {
     std::unique_ptr<LabelTask> &task;
     ~StopLabelling() { task.reset(); }
   } stop_labelling{labelling_};
-  if (labels_beside() && (params_.watertight_labels || !f.boundary.empty()))
+  // Auto mode, on more threads, labels beside the extraction too where it
+  // kept the triangulation for a closing (small, a tenth of the samples
+  // or more boundary samples): it stops once no closing is needed.
+  if ((labels_beside() && (params_.watertight_labels || !f.boundary.empty())) ||
+      (params_.mode == SC_MODE_AUTO && thread_count() > 1 && kept_))
     labelling_.reset(new LabelTask(std::move(kept_), lxyz.data(), m));
   const sc_diag_t before_prune = diag;
   std::vector<uint8_t> alive;
@@ -856,6 +860,7 @@ sc_mesh_t *Recon::finish() {
     }
     unfilled = std::vector<uint32_t>();
     kept_.reset();
+    labelling_.reset();
     diag.samples_attached =
         attach_samples(lxyz.data(), m, surf, progress, diag);
   }

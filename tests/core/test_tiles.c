@@ -223,18 +223,22 @@ static void labelling_beside(const char *path) {
     EXPECT_FAIL("%s: %s", path, msg);
     return;
   }
-  for (int labels = 0; labels < 2; ++labels) {
+  /* Watertight mode, with and without --labels, and auto mode, which
+   * closes this sample by labelling too. */
+  for (int variant = 0; variant < 3; ++variant) {
     sc_params_t p;
     sc_params_init(&p);
-    p.mode = SC_MODE_WATERTIGHT;
-    p.watertight_labels = labels;
+    p.mode = variant < 2 ? SC_MODE_WATERTIGHT : SC_MODE_AUTO;
+    p.watertight_labels = variant == 1;
     p.threads = 1;
     sc_mesh_t *one = run_with(path, pts.xyz, pts.count, &p);
     p.threads = 2;
     sc_mesh_t *two = run_with(path, pts.xyz, pts.count, &p);
     char tag[300];
-    snprintf(tag, sizeof tag, "%s, watertight%s on 2 threads", path,
-             labels ? " (labels)" : "");
+    snprintf(tag, sizeof tag, "%s, %s on 2 threads", path,
+             variant == 0   ? "watertight"
+             : variant == 1 ? "watertight (labels)"
+                            : "auto");
     if (one && two && same_output(tag, one, two)) {
       EXPECT(two->diag.labelled && two->diag.boundary_samples > 0);
       EXPECT_EQ(one->diag.path, two->diag.path);
