@@ -239,6 +239,10 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
   if (d->handles_cut)
     fprintf(f, ", %llu handle%s cut", (unsigned long long)d->handles_cut,
             d->handles_cut == 1 ? "" : "s");
+  if (d->small_handles_cut)
+    fprintf(f, ", %llu small handle%s cut",
+            (unsigned long long)d->small_handles_cut,
+            d->small_handles_cut == 1 ? "" : "s");
   fprintf(f, ".\n");
   fprintf(f, "Path %s: %llu boundary sample%s, longest loop %llu edges",
           sc_path_name(d->path), (unsigned long long)d->boundary_samples,

@@ -6,10 +6,12 @@
 //
 // SPDX-License-Identifier: GPL-3.0-or-later
 
+#include "edges.hpp"
 #include "internal.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <queue>
 
 namespace sc {
@@ -299,6 +301,193 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
   if (tris.size() < 3 * nt)
     keep_edges_of(table, keep);
   return cuts;
+}
+
+namespace {
+
+// Twice the genus of the triangles `region` of an oriented manifold
+// surface, summed over the pieces they make: pinched where the region's
+// boundary passes a vertex more than once, each fan of the region there
+// counts as a vertex of its own, and its loops are followed about their
+// vertices through the region's triangles. half: scratch.
+int64_t region_twice_genus(const std::vector<uint32_t> &tris,
+                           const std::vector<uint32_t> &region,
+                           std::vector<std::pair<uint64_t, uint32_t>> &half) {
+  const size_t f = region.size();
+  auto key = [](uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; };
+  // The region's half-edges a -> b, each with its position in the region.
+  half.clear();
+  for (size_t i = 0; i < f; ++i) {
+    const uint32_t *t = &tris[3 * size_t(region[i])];
+    for (int c = 0; c < 3; ++c)
+      half.emplace_back(key(t[c], t[(c + 1) % 3]), uint32_t(3 * i + c));
+  }
+  std::sort(half.begin(), half.end());
+  auto find_half = [&](uint32_t a, uint32_t b) -> int64_t {
+    const auto it = std::lower_bound(half.begin(), half.end(),
+                                     std::make_pair(key(a, b), uint32_t(0)));
+    return it != half.end() && it->first == key(a, b) ? int64_t(it->second)
+                                                      : -1;
+  };
+  auto vertex = [&](size_t h) {
+    return tris[3 * size_t(region[h / 3]) + h % 3];
+  };
+  auto next_in = [](size_t h) { return h - h % 3 + (h % 3 + 1) % 3; };
+  // Pieces: triangles joined across edges.
+  std::vector<uint32_t> par(f);
+  std::iota(par.begin(), par.end(), 0u);
+  auto root = [&](uint32_t x) {
+    while (par[x] != x)
+      x = par[x] = par[par[x]];
+    return x;
+  };
+  std::vector<uint8_t> boundary(3 * f, 0);
+  size_t nb = 0;
+  for (size_t h = 0; h < 3 * f; ++h) {
+    const int64_t twin = find_half(vertex(next_in(h)), vertex(h));
+    if (twin < 0) {
+      boundary[h] = 1;
+      ++nb;
+    } else {
+      const uint32_t x = root(uint32_t(h / 3)), y = root(uint32_t(twin / 3));
+      if (x != y)
+        par[x] = y;
+    }
+  }
+  int64_t pieces = 0;
+  for (size_t i = 0; i < f; ++i)
+    pieces += par[i] == i;
+  // Loops: from a boundary half-edge a -> b, the next is the boundary
+  // half-edge leaving b met turning about b through the region.
+  std::vector<uint8_t> seen(3 * f, 0);
+  int64_t loops = 0;
+  for (size_t h0 = 0; h0 < 3 * f; ++h0) {
+    if (!boundary[h0] || seen[h0])
+      continue;
+    ++loops;
+    size_t h = h0;
+    while (!seen[h]) {
+      seen[h] = 1;
+      size_t g = next_in(h); // leaves the end of h, in the same triangle
+      for (size_t guard = 0; !boundary[g] && guard < 3 * f; ++guard) {
+        const int64_t twin = find_half(vertex(next_in(g)), vertex(g));
+        g = next_in(size_t(twin));
+      }
+      h = g;
+    }
+  }
+  // Vertices: one per fan, a boundary half-edge leaving a vertex per fan
+  // of a vertex on the region's boundary.
+  std::vector<uint32_t> vs;
+  vs.reserve(3 * f);
+  for (size_t h = 0; h < 3 * f; ++h)
+    if (!boundary[h])
+      vs.push_back(vertex(h));
+  std::vector<uint32_t> on_boundary;
+  for (size_t h = 0; h < 3 * f; ++h)
+    if (boundary[h])
+      on_boundary.push_back(vertex(h));
+  std::sort(vs.begin(), vs.end());
+  vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+  std::sort(on_boundary.begin(), on_boundary.end());
+  int64_t v = int64_t(nb);
+  for (uint32_t w : vs)
+    v += !std::binary_search(on_boundary.begin(), on_boundary.end(), w);
+  const int64_t e = int64_t((3 * f + nb) / 2);
+  const int64_t chi = v - e + int64_t(f);
+  return 2 * pieces - chi - loops;
+}
+
+} // namespace
+
+size_t cut_small_handles(const double *xyz, size_t n,
+                         std::vector<uint32_t> &tris, int rings,
+                         size_t max_sites, Progress &progress) {
+  const size_t nt = tris.size() / 3;
+  // The triangles at each vertex.
+  std::vector<uint32_t> first(n + 1, 0), at(3 * nt);
+  for (uint32_t v : tris)
+    ++first[v + 1];
+  for (size_t v = 0; v < n; ++v)
+    first[v + 1] += first[v];
+  {
+    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+    for (size_t i = 0; i < 3 * nt; ++i)
+      at[fill[tris[i]]++] = uint32_t(i / 3);
+  }
+  std::vector<uint32_t> tri_stamp(nt, 0), vert_stamp(n, 0);
+  std::vector<uint8_t> covered(n, 0), cut(nt, 0);
+  std::vector<uint32_t> region, verts, front, next;
+  std::vector<std::pair<uint64_t, uint32_t>> half;
+  uint32_t stamp = 0;
+  // Each place: its triangles' area, and where its triangles are listed.
+  struct Site {
+    double area;
+    size_t from, to;
+  };
+  std::vector<Site> sites;
+  std::vector<uint32_t> site_tris;
+  for (size_t v = 0; v < n; ++v) {
+    progress.tick(v, n);
+    if (covered[v] || first[v] == first[v + 1])
+      continue;
+    ++stamp;
+    region.clear();
+    verts.assign(1, uint32_t(v));
+    vert_stamp[v] = stamp;
+    front.assign(1, uint32_t(v));
+    for (int r = 0; r < rings; ++r) {
+      next.clear();
+      for (uint32_t u : front)
+        for (uint32_t k = first[u]; k < first[u + 1]; ++k) {
+          const uint32_t t = at[k];
+          if (tri_stamp[t] == stamp)
+            continue;
+          tri_stamp[t] = stamp;
+          region.push_back(t);
+          for (int c = 0; c < 3; ++c) {
+            const uint32_t w = tris[3 * t + c];
+            if (vert_stamp[w] != stamp) {
+              vert_stamp[w] = stamp;
+              verts.push_back(w);
+              next.push_back(w);
+            }
+          }
+        }
+      front.swap(next);
+    }
+    const int64_t twice_genus = region_twice_genus(tris, region, half);
+    if (twice_genus < 2)
+      continue;
+    double area = 0;
+    for (uint32_t t : region) {
+      double nrm[3];
+      triangle_normal(xyz, tris[3 * t], tris[3 * t + 1], tris[3 * t + 2], nrm);
+      area += std::sqrt(dot3(nrm, nrm));
+    }
+    sites.push_back({area, site_tris.size(), site_tris.size() + region.size()});
+    site_tris.insert(site_tris.end(), region.begin(), region.end());
+    for (uint32_t w : verts)
+      covered[w] = 1;
+  }
+  if (sites.empty())
+    return 0;
+  // The smallest first: the tightest handles.
+  std::stable_sort(
+      sites.begin(), sites.end(),
+      [](const Site &a, const Site &b) { return a.area < b.area; });
+  if (sites.size() > max_sites)
+    sites.resize(max_sites);
+  for (const Site &st : sites)
+    for (size_t k = st.from; k < st.to; ++k)
+      cut[site_tris[k]] = 1;
+  std::vector<uint32_t> kept;
+  kept.reserve(tris.size());
+  for (size_t t = 0; t < nt; ++t)
+    if (!cut[t])
+      kept.insert(kept.end(), &tris[3 * t], &tris[3 * t] + 3);
+  tris.swap(kept);
+  return sites.size();
 }
 
 } // namespace sc

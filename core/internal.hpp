@@ -316,6 +316,11 @@ void append_edges_of(EdgeTable &et, size_t n,
 // result (as fill_holes() builds it) in `table`.
 size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                    Progress &progress, EdgeTable &table);
+// Small handles: takes out the triangles within `rings` rings of a vertex
+// wherever they hold a handle; returns how many such places.
+size_t cut_small_handles(const double *xyz, size_t n,
+                         std::vector<uint32_t> &tris, int rings,
+                         size_t max_sites, Progress &progress);
 // Closes every hole of at most max_loop edges by a least-area patch (sections 9
 // and 11.3; a loop of more than 16 edges is first cut by short chords into
 // pieces), except the loops that boundary (which may be empty) marks as where

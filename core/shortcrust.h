@@ -452,6 +452,9 @@ int sc_params_can_tile(const sc_params_t *p);
     "triangle")                                                                \
   X(handles_cut, uint64_t, , COUNT, "handles_cut",                             \
     "watertight: handles that closed round a hole, cut before closing")        \
+  X(small_handles_cut, uint64_t, , COUNT, "small_handles_cut",                 \
+    "watertight: small handles cut from the closure by labels, beyond the "    \
+    "extracted surface's genus")                                               \
   X(hull_facets, uint64_t, , COUNT, "hull_facets",                             \
     "triangles of the convex hull")                                            \
   X(spacing, double, , REAL, "spacing",                                        \

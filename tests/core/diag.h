@@ -75,10 +75,11 @@ static inline sc_mesh_t *sct_expect_closed(const double *xyz, size_t n,
   EXPECT_EQ(scs_meshcheck(n, xyz, m->triangles, m->triangle_count, NULL, &c),
             0);
   char line[512];
-  printf("%s: %s; %llu attached, %llu handles cut\n", what,
-         scs_meshcheck_summary(&c, line, sizeof line),
+  printf("%s: %s; %llu attached, %llu handles cut, %llu small handles cut\n",
+         what, scs_meshcheck_summary(&c, line, sizeof line),
          (unsigned long long)m->diag.samples_attached,
-         (unsigned long long)m->diag.handles_cut);
+         (unsigned long long)m->diag.handles_cut,
+         (unsigned long long)m->diag.small_handles_cut);
   EXPECT_CLOSED_PIECE(m->diag, c, genus, n);
   if (every_sample) {
     EXPECT_EQ(m->diag.samples_unused, 0);

@@ -5,7 +5,10 @@
  * genus (measured on the mesh itself) with every sample a vertex. The
  * fandisk's sharp edges at 10 000 random points: the patches span the
  * strips the candidates miss along them, and the samples over those
- * patches must be attached however far the patches' corners lie.
+ * patches must be attached however far the patches' corners lie. The
+ * dino at as many random points as it has vertices: the patches break a
+ * leg off, and the labelling keeps it but with a small false handle,
+ * which must be cut (docs/algorithm.md section 11.5).
  *
  *   test_core_mesh_sample MESH.ply N SEED MODE [patches]
  *
