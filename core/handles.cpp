@@ -305,35 +305,44 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 
 namespace {
 
-// Twice the genus of the triangles `region` of an oriented manifold
-// surface, summed over the pieces they make: pinched where the region's
-// boundary passes a vertex more than once, each fan of the region there
-// counts as a vertex of its own, and its loops are followed about their
-// vertices through the region's triangles. half: scratch.
+// Twice the genus of the triangles `region` of a closed, oriented manifold
+// surface, summed over the pieces they make across edges; in_region(t)
+// tells a triangle of it, across[3t + c] the triangle beyond edge c of t
+// (from corner c to c + 1). Where the region's boundary passes a vertex
+// more than once, each fan of the region there counts as a vertex of its
+// own, and the loops are followed about their vertices through the
+// region's triangles. mark: scratch, a byte per vertex, left all 0.
+template <class InRegion>
 int64_t region_twice_genus(const std::vector<uint32_t> &tris,
+                           const std::vector<uint32_t> &across,
                            const std::vector<uint32_t> &region,
-                           std::vector<std::pair<uint64_t, uint32_t>> &half) {
+                           InRegion in_region, std::vector<uint8_t> &mark) {
   const size_t f = region.size();
-  auto key = [](uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; };
-  // The region's half-edges a -> b, each with its position in the region.
-  half.clear();
-  for (size_t i = 0; i < f; ++i) {
-    const uint32_t *t = &tris[3 * size_t(region[i])];
-    for (int c = 0; c < 3; ++c)
-      half.emplace_back(key(t[c], t[(c + 1) % 3]), uint32_t(3 * i + c));
-  }
-  std::sort(half.begin(), half.end());
-  auto find_half = [&](uint32_t a, uint32_t b) -> int64_t {
-    const auto it = std::lower_bound(half.begin(), half.end(),
-                                     std::make_pair(key(a, b), uint32_t(0)));
-    return it != half.end() && it->first == key(a, b) ? int64_t(it->second)
-                                                      : -1;
-  };
-  auto vertex = [&](size_t h) {
-    return tris[3 * size_t(region[h / 3]) + h % 3];
-  };
+  // Half-edges by (triangle, corner): h = 3 t + c runs from corner c to
+  // corner c + 1.
   auto next_in = [](size_t h) { return h - h % 3 + (h % 3 + 1) % 3; };
-  // Pieces: triangles joined across edges.
+  auto inside = [&](size_t h) {
+    return across[h] != UINT32_MAX && in_region(across[h]);
+  };
+  // The half-edge of triangle u that runs b -> a, twin of h = a -> b.
+  auto twin = [&](size_t h) {
+    const uint32_t u = across[h], a = tris[h], b = tris[next_in(h)];
+    for (int c = 0; c < 3; ++c)
+      if (tris[3 * size_t(u) + c] == b &&
+          tris[3 * size_t(u) + (c + 1) % 3] == a)
+        return 3 * size_t(u) + c;
+    return size_t(SIZE_MAX); // not manifold there
+  };
+  // Pieces across edges, by union-find over positions in region (found
+  // from the triangle by a search).
+  std::vector<std::pair<uint32_t, uint32_t>> pos(f);
+  for (size_t i = 0; i < f; ++i)
+    pos[i] = {region[i], uint32_t(i)};
+  std::sort(pos.begin(), pos.end());
+  auto position = [&](uint32_t t) {
+    return std::lower_bound(pos.begin(), pos.end(), std::make_pair(t, 0u))
+        ->second;
+  };
   std::vector<uint32_t> par(f);
   std::iota(par.begin(), par.end(), 0u);
   auto root = [&](uint32_t x) {
@@ -341,59 +350,61 @@ int64_t region_twice_genus(const std::vector<uint32_t> &tris,
       x = par[x] = par[par[x]];
     return x;
   };
-  std::vector<uint8_t> boundary(3 * f, 0);
-  size_t nb = 0;
-  for (size_t h = 0; h < 3 * f; ++h) {
-    const int64_t twin = find_half(vertex(next_in(h)), vertex(h));
-    if (twin < 0) {
-      boundary[h] = 1;
-      ++nb;
-    } else {
-      const uint32_t x = root(uint32_t(h / 3)), y = root(uint32_t(twin / 3));
-      if (x != y)
-        par[x] = y;
+  int64_t nb = 0, loops = 0, v = 0;
+  for (size_t i = 0; i < f; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const size_t h = 3 * size_t(region[i]) + c;
+      if (!inside(h)) {
+        ++nb;
+        mark[tris[h]] = 1; // a vertex with a fan ending here
+      } else if (across[h] > region[i]) {
+        const uint32_t x = root(uint32_t(i)), y = root(position(across[h]));
+        if (x != y)
+          par[x] = y;
+      }
     }
-  }
   int64_t pieces = 0;
   for (size_t i = 0; i < f; ++i)
     pieces += par[i] == i;
   // Loops: from a boundary half-edge a -> b, the next is the boundary
-  // half-edge leaving b met turning about b through the region.
+  // half-edge leaving b met turning about b through the region; seen
+  // marks them by position in region and corner.
   std::vector<uint8_t> seen(3 * f, 0);
-  int64_t loops = 0;
-  for (size_t h0 = 0; h0 < 3 * f; ++h0) {
-    if (!boundary[h0] || seen[h0])
-      continue;
-    ++loops;
-    size_t h = h0;
-    while (!seen[h]) {
-      seen[h] = 1;
-      size_t g = next_in(h); // leaves the end of h, in the same triangle
-      for (size_t guard = 0; !boundary[g] && guard < 3 * f; ++guard) {
-        const int64_t twin = find_half(vertex(next_in(g)), vertex(g));
-        g = next_in(size_t(twin));
+  for (size_t i = 0; i < f; ++i)
+    for (int c = 0; c < 3; ++c) {
+      size_t h = 3 * size_t(region[i]) + c;
+      if (inside(h) || seen[3 * i + c])
+        continue;
+      ++loops;
+      size_t k = 3 * i + c;
+      while (!seen[k]) {
+        seen[k] = 1;
+        size_t g = next_in(h); // leaves the end of h
+        for (size_t guard = 0; inside(g) && guard < 3 * f; ++guard) {
+          const size_t tw = twin(g);
+          if (tw == SIZE_MAX)
+            return 0;
+          g = next_in(tw);
+        }
+        h = g;
+        k = 3 * size_t(position(uint32_t(h / 3))) + h % 3;
       }
-      h = g;
     }
-  }
-  // Vertices: one per fan, a boundary half-edge leaving a vertex per fan
-  // of a vertex on the region's boundary.
-  std::vector<uint32_t> vs;
-  vs.reserve(3 * f);
-  for (size_t h = 0; h < 3 * f; ++h)
-    if (!boundary[h])
-      vs.push_back(vertex(h));
-  std::vector<uint32_t> on_boundary;
-  for (size_t h = 0; h < 3 * f; ++h)
-    if (boundary[h])
-      on_boundary.push_back(vertex(h));
-  std::sort(vs.begin(), vs.end());
-  vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
-  std::sort(on_boundary.begin(), on_boundary.end());
-  int64_t v = int64_t(nb);
-  for (uint32_t w : vs)
-    v += !std::binary_search(on_boundary.begin(), on_boundary.end(), w);
-  const int64_t e = int64_t((3 * f + nb) / 2);
+  // Vertices: one per fan; a vertex with a boundary half-edge leaving it
+  // has one fan per such half-edge (nb in all), the others one.
+  for (size_t i = 0; i < f; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t w = tris[3 * size_t(region[i]) + c];
+      if (mark[w] == 0) {
+        mark[w] = 2;
+        ++v;
+      }
+    }
+  v += nb;
+  for (size_t i = 0; i < f; ++i)
+    for (int c = 0; c < 3; ++c)
+      mark[tris[3 * size_t(region[i]) + c]] = 0;
+  const int64_t e = (3 * int64_t(f) + nb) / 2;
   const int64_t chi = v - e + int64_t(f);
   return 2 * pieces - chi - loops;
 }
@@ -401,7 +412,8 @@ int64_t region_twice_genus(const std::vector<uint32_t> &tris,
 } // namespace
 
 size_t cut_small_handles(const double *xyz, size_t n,
-                         std::vector<uint32_t> &tris, int rings,
+                         std::vector<uint32_t> &tris,
+                         const std::vector<uint8_t> &seed, int rings,
                          size_t max_sites, Progress &progress) {
   const size_t nt = tris.size() / 3;
   // The triangles at each vertex.
@@ -415,10 +427,29 @@ size_t cut_small_handles(const double *xyz, size_t n,
     for (size_t i = 0; i < 3 * nt; ++i)
       at[fill[tris[i]]++] = uint32_t(i / 3);
   }
+  // The triangle across each edge (edge c of t runs from corner c to
+  // corner c + 1), UINT32_MAX where there is none.
+  std::vector<uint32_t> across(3 * nt, UINT32_MAX);
+  {
+    std::vector<std::pair<uint64_t, uint32_t>> edge(3 * nt);
+    for (size_t i = 0; i < 3 * nt; ++i) {
+      const uint32_t a = tris[i], b = tris[i - i % 3 + (i % 3 + 1) % 3];
+      edge[i] = {(uint64_t(a) << 32) | b, uint32_t(i / 3)};
+    }
+    std::sort(edge.begin(), edge.end());
+    for (size_t i = 0; i < 3 * nt; ++i) {
+      const uint32_t a = tris[i], b = tris[i - i % 3 + (i % 3 + 1) % 3];
+      const uint64_t twin = (uint64_t(b) << 32) | a;
+      const auto it = std::lower_bound(edge.begin(), edge.end(),
+                                       std::make_pair(twin, uint32_t(0)));
+      if (it != edge.end() && it->first == twin)
+        across[i] = it->second;
+    }
+  }
   std::vector<uint32_t> tri_stamp(nt, 0), vert_stamp(n, 0);
   std::vector<uint8_t> covered(n, 0), cut(nt, 0);
   std::vector<uint32_t> region, verts, front, next;
-  std::vector<std::pair<uint64_t, uint32_t>> half;
+  std::vector<uint8_t> mark(n, 0);
   uint32_t stamp = 0;
   // Each place: its triangles' area, and where its triangles are listed.
   struct Site {
@@ -429,7 +460,7 @@ size_t cut_small_handles(const double *xyz, size_t n,
   std::vector<uint32_t> site_tris;
   for (size_t v = 0; v < n; ++v) {
     progress.tick(v, n);
-    if (covered[v] || first[v] == first[v + 1])
+    if (!seed[v] || covered[v] || first[v] == first[v + 1])
       continue;
     ++stamp;
     region.clear();
@@ -456,7 +487,22 @@ size_t cut_small_handles(const double *xyz, size_t n,
         }
       front.swap(next);
     }
-    const int64_t twice_genus = region_twice_genus(tris, region, half);
+    // A disc (Euler characteristic 1) holds no handle, and is what nearly
+    // every region is: counted from the edges to triangles outside it
+    // before anything is sorted. (Its vertices counted once, the
+    // characteristic is at most that of region_twice_genus(), and a
+    // handle in one or two pieces needs it at most 0.)
+    int64_t outside = 0;
+    for (uint32_t t : region)
+      for (int c = 0; c < 3; ++c)
+        outside += across[3 * t + c] == UINT32_MAX ||
+                   tri_stamp[across[3 * t + c]] != stamp;
+    const int64_t f = int64_t(region.size());
+    if (2 * int64_t(verts.size()) - f - outside > 0)
+      continue;
+    const int64_t twice_genus = region_twice_genus(
+        tris, across, region, [&](uint32_t t) { return tri_stamp[t] == stamp; },
+        mark);
     if (twice_genus < 2)
       continue;
     double area = 0;
