@@ -412,8 +412,7 @@ int64_t region_twice_genus(const std::vector<uint32_t> &tris,
 } // namespace
 
 size_t cut_small_handles(const double *xyz, size_t n,
-                         std::vector<uint32_t> &tris,
-                         const std::vector<uint8_t> &seed, int rings,
+                         std::vector<uint32_t> &tris, int rings,
                          size_t max_sites, Progress &progress) {
   const size_t nt = tris.size() / 3;
   // The triangles at each vertex.
@@ -460,7 +459,7 @@ size_t cut_small_handles(const double *xyz, size_t n,
   std::vector<uint32_t> site_tris;
   for (size_t v = 0; v < n; ++v) {
     progress.tick(v, n);
-    if (!seed[v] || covered[v] || first[v] == first[v + 1])
+    if (covered[v] || first[v] == first[v + 1])
       continue;
     ++stamp;
     region.clear();

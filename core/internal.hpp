@@ -317,12 +317,11 @@ void append_edges_of(EdgeTable &et, size_t n,
 size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                    Progress &progress, EdgeTable &table);
 // Small handles of a closed, oriented manifold surface (section 11.5):
-// takes out the triangles within `rings` rings of a vertex marked in seed
-// wherever they hold a handle, the smallest in area first and at most
-// max_sites places; returns how many.
+// takes out the triangles within `rings` rings of a vertex wherever they
+// hold a handle, the smallest in area first and at most max_sites places;
+// returns how many.
 size_t cut_small_handles(const double *xyz, size_t n,
-                         std::vector<uint32_t> &tris,
-                         const std::vector<uint8_t> &seed, int rings,
+                         std::vector<uint32_t> &tris, int rings,
                          size_t max_sites, Progress &progress);
 // Closes every hole of at most max_loop edges by a least-area patch (sections 9
 // and 11.3; a loop of more than 16 edges is first cut by short chords into

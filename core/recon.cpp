@@ -7,7 +7,6 @@
 #include "internal.hpp"
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <climits>
 #include <cmath>
@@ -321,25 +320,6 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   // round is kept only where the result is one closed manifold in no more
   // pieces. Never below the extracted surface's genus: its handles have
   // the candidates' support.
-  // The vertices of the triangles of tris that the patches' closure does
-  // not have: a handle beyond the extracted surface's passes one.
-  auto made_by_labels = [&](const std::vector<uint32_t> &tris) {
-    auto key = [](const uint32_t *t) {
-      std::array<uint32_t, 3> k = {t[0], t[1], t[2]};
-      std::sort(k.begin(), k.end());
-      return k;
-    };
-    std::vector<std::array<uint32_t, 3>> theirs;
-    theirs.reserve(surf.tris.size() / 3);
-    for (size_t i = 0; i < surf.tris.size(); i += 3)
-      theirs.push_back(key(&surf.tris[i]));
-    std::sort(theirs.begin(), theirs.end());
-    std::vector<uint8_t> seed(m, 0);
-    for (size_t i = 0; i < tris.size(); i += 3)
-      if (!std::binary_search(theirs.begin(), theirs.end(), key(&tris[i])))
-        seed[tris[i]] = seed[tris[i + 1]] = seed[tris[i + 2]] = 1;
-    return seed;
-  };
   auto small_handles = [&] {
     const Closure p(diag);
     const int64_t bound = p.genus + int64_t(diag.handles_cut);
@@ -350,9 +330,8 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
       if (!p.ok || !l.ok || l.genus <= bound)
         return;
       std::vector<uint32_t> t = a.tris;
-      const size_t sites =
-          cut_small_handles(lxyz, m, t, made_by_labels(a.tris), rings,
-                            size_t(l.genus - bound), progress);
+      const size_t sites = cut_small_handles(lxyz, m, t, rings,
+                                             size_t(l.genus - bound), progress);
       Surface b;
       sc_diag_t db = da;
       if (sites) {
