@@ -317,9 +317,10 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   // handles they cut), those that fit in a few rings of triangles about a
   // vertex are cut out, tightest first and no more than that excess, and
   // the holes patched; rings are widened once no more are found, and a
-  // round is kept only where the result is one closed manifold in no more
-  // pieces. Never below the extracted surface's genus: its handles have
-  // the candidates' support.
+  // round is kept only where the result is a closed manifold in no more
+  // components, once the pieces under a hundredth of it that a cut split
+  // off are dropped. Never below the extracted surface's genus: its
+  // handles have the candidates' support.
   auto small_handles = [&] {
     const Closure p(diag);
     const int64_t bound = p.genus + int64_t(diag.handles_cut);
@@ -337,9 +338,14 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
       if (sites) {
         fill_holes(lxyz, m, t, kMaxFillLoop, {}, progress, db, kMaxFillWork);
         describe_manifold(t, b, db);
+        // A cut across a thin part can split a small piece off: a pocket,
+        // which goes as the pockets of the closing do (below).
+        if (db.components > l.components)
+          drop_small_closed(lxyz, m, b, b.tris.size() / 3 / 100, false,
+                            progress, db);
       }
       const Closure c(db);
-      if (!sites || !c.ok || c.loops > 0 || pieces(b) > pieces(a) ||
+      if (!sites || !c.ok || c.loops > 0 || c.components > l.components ||
           c.genus >= l.genus || c.genus < bound) {
         ++rings;
         continue;
