@@ -306,43 +306,25 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 namespace {
 
 // Twice the genus of the triangles `region` of a closed, oriented manifold
-// surface, summed over the pieces they make across edges; in_region(t)
-// tells a triangle of it, across[3t + c] the triangle beyond edge c of t
-// (from corner c to c + 1). Where the region's boundary passes a vertex
+// surface, summed over the pieces they make across edges; twin[h] is the
+// other half-edge of half-edge h = 3 t + c (from corner c of triangle t to
+// corner c + 1, pair_half_edges()), at[t] the place of triangle t in
+// region when in_region(t). Where the region's boundary passes a vertex
 // more than once, each fan of the region there counts as a vertex of its
 // own, and the loops are followed about their vertices through the
 // region's triangles. mark: scratch, a byte per vertex, left all 0.
 template <class InRegion>
 int64_t region_twice_genus(const std::vector<uint32_t> &tris,
-                           const std::vector<uint32_t> &across,
+                           const std::vector<uint32_t> &twin,
                            const std::vector<uint32_t> &region,
-                           InRegion in_region, std::vector<uint8_t> &mark) {
+                           const std::vector<uint32_t> &at, InRegion in_region,
+                           std::vector<uint8_t> &mark) {
   const size_t f = region.size();
-  // Half-edges by (triangle, corner): h = 3 t + c runs from corner c to
-  // corner c + 1.
   auto next_in = [](size_t h) { return h - h % 3 + (h % 3 + 1) % 3; };
   auto inside = [&](size_t h) {
-    return across[h] != UINT32_MAX && in_region(across[h]);
+    return twin[h] != UINT32_MAX && in_region(twin[h] / 3);
   };
-  // The half-edge of triangle u that runs b -> a, twin of h = a -> b.
-  auto twin = [&](size_t h) {
-    const uint32_t u = across[h], a = tris[h], b = tris[next_in(h)];
-    for (int c = 0; c < 3; ++c)
-      if (tris[3 * size_t(u) + c] == b &&
-          tris[3 * size_t(u) + (c + 1) % 3] == a)
-        return 3 * size_t(u) + c;
-    return size_t(SIZE_MAX); // not manifold there
-  };
-  // Pieces across edges, by union-find over positions in region (found
-  // from the triangle by a search).
-  std::vector<std::pair<uint32_t, uint32_t>> pos(f);
-  for (size_t i = 0; i < f; ++i)
-    pos[i] = {region[i], uint32_t(i)};
-  std::sort(pos.begin(), pos.end());
-  auto position = [&](uint32_t t) {
-    return std::lower_bound(pos.begin(), pos.end(), std::make_pair(t, 0u))
-        ->second;
-  };
+  // Pieces across edges, by union-find over places in region.
   std::vector<uint32_t> par(f);
   std::iota(par.begin(), par.end(), 0u);
   auto root = [&](uint32_t x) {
@@ -357,8 +339,8 @@ int64_t region_twice_genus(const std::vector<uint32_t> &tris,
       if (!inside(h)) {
         ++nb;
         mark[tris[h]] = 1; // a vertex with a fan ending here
-      } else if (across[h] > region[i]) {
-        const uint32_t x = root(uint32_t(i)), y = root(position(across[h]));
+      } else {
+        const uint32_t x = root(uint32_t(i)), y = root(at[twin[h] / 3]);
         if (x != y)
           par[x] = y;
       }
@@ -368,7 +350,7 @@ int64_t region_twice_genus(const std::vector<uint32_t> &tris,
     pieces += par[i] == i;
   // Loops: from a boundary half-edge a -> b, the next is the boundary
   // half-edge leaving b met turning about b through the region; seen
-  // marks them by position in region and corner.
+  // marks them by place in region and corner.
   std::vector<uint8_t> seen(3 * f, 0);
   for (size_t i = 0; i < f; ++i)
     for (int c = 0; c < 3; ++c) {
@@ -376,18 +358,11 @@ int64_t region_twice_genus(const std::vector<uint32_t> &tris,
       if (inside(h) || seen[3 * i + c])
         continue;
       ++loops;
-      size_t k = 3 * i + c;
-      while (!seen[k]) {
+      for (size_t k = 3 * i + c; !seen[k]; k = 3 * size_t(at[h / 3]) + h % 3) {
         seen[k] = 1;
-        size_t g = next_in(h); // leaves the end of h
-        for (size_t guard = 0; inside(g) && guard < 3 * f; ++guard) {
-          const size_t tw = twin(g);
-          if (tw == SIZE_MAX)
-            return 0;
-          g = next_in(tw);
-        }
-        h = g;
-        k = 3 * size_t(position(uint32_t(h / 3))) + h % 3;
+        h = next_in(h); // leaves the end of the last one
+        for (size_t guard = 0; inside(h) && guard < 3 * f; ++guard)
+          h = next_in(twin[h]);
       }
     }
   // Vertices: one per fan; a vertex with a boundary half-edge leaving it
@@ -415,36 +390,15 @@ size_t cut_small_handles(const double *xyz, size_t n,
                          std::vector<uint32_t> &tris, int rings,
                          size_t max_sites, Progress &progress) {
   const size_t nt = tris.size() / 3;
-  // The triangles at each vertex.
-  std::vector<uint32_t> first(n + 1, 0), at(3 * nt);
-  for (uint32_t v : tris)
-    ++first[v + 1];
-  for (size_t v = 0; v < n; ++v)
-    first[v + 1] += first[v];
+  VertexStar star;
+  star.build(n, tris, [](size_t) { return true; });
+  std::vector<uint32_t> twin;
   {
-    std::vector<uint32_t> fill(first.begin(), first.end() - 1);
-    for (size_t i = 0; i < 3 * nt; ++i)
-      at[fill[tris[i]]++] = uint32_t(i / 3);
+    EdgeTable table;
+    pair_half_edges(n, tris, progress, twin, table);
   }
-  // The triangle across each edge (edge c of t runs from corner c to
-  // corner c + 1), UINT32_MAX where there is none.
-  std::vector<uint32_t> across(3 * nt, UINT32_MAX);
-  {
-    std::vector<std::pair<uint64_t, uint32_t>> edge(3 * nt);
-    for (size_t i = 0; i < 3 * nt; ++i) {
-      const uint32_t a = tris[i], b = tris[i - i % 3 + (i % 3 + 1) % 3];
-      edge[i] = {(uint64_t(a) << 32) | b, uint32_t(i / 3)};
-    }
-    std::sort(edge.begin(), edge.end());
-    for (size_t i = 0; i < 3 * nt; ++i) {
-      const uint32_t a = tris[i], b = tris[i - i % 3 + (i % 3 + 1) % 3];
-      const uint64_t twin = (uint64_t(b) << 32) | a;
-      const auto it = std::lower_bound(edge.begin(), edge.end(),
-                                       std::make_pair(twin, uint32_t(0)));
-      if (it != edge.end() && it->first == twin)
-        across[i] = it->second;
-    }
-  }
+  // Each triangle's place in the region under way.
+  std::vector<uint32_t> place(nt, 0);
   std::vector<uint32_t> tri_stamp(nt, 0), vert_stamp(n, 0);
   std::vector<uint8_t> covered(n, 0), cut(nt, 0);
   std::vector<uint32_t> region, verts, front, next;
@@ -459,7 +413,7 @@ size_t cut_small_handles(const double *xyz, size_t n,
   std::vector<uint32_t> site_tris;
   for (size_t v = 0; v < n; ++v) {
     progress.tick(v, n);
-    if (covered[v] || first[v] == first[v + 1])
+    if (covered[v] || star.first[v] == star.first[v + 1])
       continue;
     ++stamp;
     region.clear();
@@ -469,11 +423,12 @@ size_t cut_small_handles(const double *xyz, size_t n,
     for (int r = 0; r < rings; ++r) {
       next.clear();
       for (uint32_t u : front)
-        for (uint32_t k = first[u]; k < first[u + 1]; ++k) {
-          const uint32_t t = at[k];
+        for (uint32_t k = star.first[u]; k < star.first[u + 1]; ++k) {
+          const uint32_t t = star.tris[k];
           if (tri_stamp[t] == stamp)
             continue;
           tri_stamp[t] = stamp;
+          place[t] = uint32_t(region.size());
           region.push_back(t);
           for (int c = 0; c < 3; ++c) {
             const uint32_t w = tris[3 * t + c];
@@ -494,14 +449,14 @@ size_t cut_small_handles(const double *xyz, size_t n,
     int64_t outside = 0;
     for (uint32_t t : region)
       for (int c = 0; c < 3; ++c)
-        outside += across[3 * t + c] == UINT32_MAX ||
-                   tri_stamp[across[3 * t + c]] != stamp;
+        outside += twin[3 * t + c] == UINT32_MAX ||
+                   tri_stamp[twin[3 * t + c] / 3] != stamp;
     const int64_t f = int64_t(region.size());
     if (2 * int64_t(verts.size()) - f - outside > 0)
       continue;
     const int64_t twice_genus = region_twice_genus(
-        tris, across, region, [&](uint32_t t) { return tri_stamp[t] == stamp; },
-        mark);
+        tris, twin, region, place,
+        [&](uint32_t t) { return tri_stamp[t] == stamp; }, mark);
     if (twice_genus < 2)
       continue;
     double area = 0;

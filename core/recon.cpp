@@ -323,12 +323,14 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   // handles have the candidates' support.
   auto small_handles = [&] {
     const Closure p(diag);
+    if (!p.ok)
+      return;
     const int64_t bound = p.genus + int64_t(diag.handles_cut);
     int rings = kSmallHandleRings;
     for (int round = 0;
          round < kSmallHandleRounds && rings <= kSmallHandleRingsMax; ++round) {
       const Closure l(da);
-      if (!p.ok || !l.ok || l.genus <= bound)
+      if (!l.ok || l.genus <= bound)
         return;
       std::vector<uint32_t> t = a.tris;
       const size_t sites = cut_small_handles(lxyz, m, t, rings,
