@@ -468,6 +468,8 @@ private:
   // How far each tile holds the points beyond its region from the start.
   double tile_margin() const { return 3 * noise_.spacing; }
   void insert_range(const double *xyz, size_t first, size_t n);
+  void insert_range(const double *xyz, size_t first, size_t n,
+                    Progress &progress);
   // Auto mode: whether watertight mode's closing of surf, extracted with
   // no hole filled, is one closed piece of lower genus than `genus`; then
   // surf and diag take that closure.
@@ -503,6 +505,10 @@ private:
   // (LabelTask): on more than one thread, unless the patches come first.
   bool labels_beside() const;
   void prepare(Progress &progress);
+  void prepare_and_insert(Progress &progress);
+  const double *recentred();
+  bool smooths(const NoiseEstimate &e) const;
+  void smooth_if_noisy(const double *base, Progress &progress);
   sc_params_t params_;
   std::vector<double> own_;
   const double *xyz_ = nullptr;

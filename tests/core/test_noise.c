@@ -116,6 +116,10 @@ int main(int argc, char **argv) {
     sc_mesh_t *m2 = NULL;
     ASSERT_EQ(sc_reconstruct(xyz, n, &q, &m2, msg, sizeof msg), 0);
     EXPECT_NULL(m2->smoothed);
+    /* The estimate ran beside a triangulation of the raw points, which it
+     * stopped: the same estimate to the last bit. */
+    EXPECT(m2->diag.noise == m->diag.noise &&
+           m2->diag.spacing == m->diag.spacing);
     EXPECT(m2->triangle_count == m->triangle_count &&
            memcmp(m2->triangles, m->triangles,
                   3 * m->triangle_count * sizeof *m->triangles) == 0);
@@ -177,6 +181,17 @@ int main(int argc, char **argv) {
     q.denoise = 0;
     sc_mesh_t *m2 = NULL;
     ASSERT_EQ(sc_reconstruct(xyz, n, &q, &m2, msg, sizeof msg), 0);
+    EXPECT(m2->triangle_count == m->triangle_count &&
+           memcmp(m2->triangles, m->triangles,
+                  3 * m->triangle_count * sizeof *m->triangles) == 0);
+    sc_mesh_free(m2);
+    /* On 2 threads the estimate runs beside the triangulation, which it
+     * lets finish: the same estimate and triangles. */
+    q = p;
+    q.threads = 2;
+    ASSERT_EQ(sc_reconstruct(xyz, n, &q, &m2, msg, sizeof msg), 0);
+    EXPECT(m2->diag.noise == m->diag.noise &&
+           m2->diag.spacing == m->diag.spacing && !m2->diag.denoised);
     EXPECT(m2->triangle_count == m->triangle_count &&
            memcmp(m2->triangles, m->triangles,
                   3 * m->triangle_count * sizeof *m->triangles) == 0);
