@@ -5,10 +5,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 
 #include "delaunay.hpp"
+#include "parallel.hpp"
 
 namespace sc {
 namespace dt {
 namespace {
+
+// Triangulations of at least so many cells are scanned on more threads,
+// when given them.
+constexpr size_t kParallelCells = 1u << 16;
 
 // Where a point of the dual Voronoi edge lies relative to the cocone of a
 // sample: -1 or +1 in one of the two cones around the pole, 0 inside the
@@ -137,104 +142,29 @@ private:
   double cos_theta1_[kNearR], tan_phi_[kNearR];
 };
 
-} // namespace
-
-template <class DT>
-void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
-                       const sc_params_t &params, Progress &progress,
-                       std::vector<uint32_t> &tris, sc_diag_t &diag,
-                       const Ownership *own, Checks *check) {
+// The pass over the facets, from the cells given to visit(): each facet
+// between two finite cells from the cell at the lower address, which reads
+// nothing of the other cell but its circumcentre; the hull's facets from
+// hull(). Whatever cells one scan is given, it writes only its own
+// lists, so that scans of separate cells may run on separate threads.
+template <class DT> class FacetScan {
+public:
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
-  // Room for the candidates (a closed surface has two triangles per
-  // sample, the candidates a few more), and the part of it surely filled
-  // resident at once (prefault.hpp; a tile's triangulation holds its
-  // neighbours' points too, an open scan fewer triangles): growing the
-  // list by doubling touched every page twice, a fault each.
-  const size_t have = tris.size(), nv = dt.number_of_vertices();
-  if (tris.capacity() < have + 15 * nv / 2) {
-    tris.reserve(have + 15 * nv / 2);
-    prefault(tris.data() + have, 9 * nv / 2 * sizeof(uint32_t));
+
+  FacetScan(const sc_params_t &params, const Ownership *own,
+            std::vector<uint32_t> &tris, Checks *check)
+      : cr_(params), cocone_cr_(params), near_(params),
+        detect_(detects_boundary(params.mode)),
+        cocone_(cr_.mode == SC_MODE_COCONE || check), own_(own), tris_(tris),
+        check_(check) {
+    // The check's test: the cocone's (at every vertex: shortcrust mode
+    // detects no boundary).
+    cocone_cr_.mode = SC_MODE_COCONE;
   }
-  Criteria cr(params);
-  // The check's test: the cocone's (at every vertex: shortcrust mode
-  // detects no boundary).
-  Criteria cocone_cr(params);
-  cocone_cr.mode = SC_MODE_COCONE;
-  const NearR near(params);
-  const bool detect = detects_boundary(params.mode);
-  size_t cells = dt.number_of_cells(), k = 0;
-  V3 cc, P[3], poles[3], CP[4], Cpoles[4];
-  bool interior[3] = {true, true, true}, Cinterior[4];
-  int side1[3] = {0, 0, 0}, Cside[4] = {0, 0, 0, 0};
-  uint32_t idx[3], Cidx[4];
-  const bool cocone = cr.mode == SC_MODE_COCONE || check;
-  // A cell's circumcentre and four vertices, read once for the facets it
-  // handles.
-  auto load = [&](Ch c) {
-    const float *ccc = c->info().cc;
-    cc = {ccc[0], ccc[1], ccc[2]};
-    for (int j = 0; j < 4; ++j) {
-      Vh v = c->vertex(j);
-      const VertexData &d = v->info();
-      CP[j] = v3(v->point());
-      Cpoles[j] = {d.pole[0], d.pole[1], d.pole[2]};
-      Cidx[j] = d.idx;
-      Cinterior[j] = !detect || (d.flags & kVInterior) != 0;
-      if (cocone && Cinterior[j])
-        Cside[j] = cone_side(cc - CP[j], Cpoles[j], cr.sin2_cocone);
-    }
-  };
-  // Facet f of the cell loaded, whose dual Voronoi edge runs from its
-  // circumcentre to `other`, or leaves the hull outward when `ray`.
-  auto facet = [&](int f, V3 other, bool ray) {
-    // The corners in the order of their vertex numbers: how a cell orders
-    // its vertices depends on the order of insertion, and the rounding of
-    // the tests on the order of the corners; this way a facet gets the same
-    // answer whichever of its cells, and whichever triangulation (one, or a
-    // tile's), reports it.
-    int ci[3] = {(f + 1) % 4, (f + 2) % 4, (f + 3) % 4};
-    auto order = [&](int a, int b) {
-      if (Cidx[ci[b]] < Cidx[ci[a]])
-        std::swap(ci[a], ci[b]);
-    };
-    order(0, 1), order(1, 2), order(0, 1);
-    if (own && !(*own)(Cidx[ci[0]]))
-      return;
-    ++diag.delaunay_facets;
-    for (int j = 0; j < 3; ++j) {
-      const int i = ci[j];
-      P[j] = CP[i];
-      poles[j] = Cpoles[i];
-      idx[j] = Cidx[i];
-      interior[j] = Cinterior[i];
-      side1[j] = Cside[i];
-    }
-    if (ray) {
-      V3 nrm = cross(P[1] - P[0], P[2] - P[0]);
-      V3 o = CP[f];
-      other = dot(nrm, o - P[0]) > 0 ? -1.0 * nrm : nrm;
-    }
-    if (!check) {
-      if (is_candidate(cr, P, poles, interior, side1, cc, other, ray))
-        tris.insert(tris.end(), idx, idx + 3);
-      return;
-    }
-    // Shortcrust mode with its check: the criteria once, at every r near.
-    const int least = near.least(P, poles, cc, other, ray);
-    if (least <= kNearR / 2)
-      tris.insert(tris.end(), idx, idx + 3);
-    if (least < kNearR)
-      check->near[least].insert(check->near[least].end(), idx, idx + 3);
-    if (is_candidate(cocone_cr, P, poles, interior, side1, cc, other, ray))
-      check->cocone.insert(check->cocone.end(), idx, idx + 3);
-  };
-  // Each facet between two finite cells is handled from the cell at the
-  // lower address, which reads nothing of the other cell but its
-  // circumcentre (for_cells() asks for that in advance); the facets of the
-  // hull come after.
-  for_cells(dt, true, [&](auto c) {
-    progress.tick(k++, cells);
+
+  // The facets that cell c reports.
+  template <class It> void cell(It c) {
     bool loaded = false;
     for (int f = 0; f < 4; ++f) {
       Ch nb = c->neighbor(f);
@@ -247,20 +177,185 @@ void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
       const float *oc = nb->info().cc;
       facet(f, {oc[0], oc[1], oc[2]}, false);
     }
-  });
-  for (Ch o : infinite) {
-    Ch c = o->neighbor(o->index(dt.infinite_vertex()));
+  }
+
+  // The facet of the hull of infinite cell o.
+  void hull(Ch o, Vh infinite) {
+    Ch c = o->neighbor(o->index(infinite));
     load(c);
     facet(c->index(o), {0, 0, 0}, true);
   }
+
+  uint64_t facets() const { return facets_; }
+
+private:
+  // A cell's circumcentre and four vertices, read once for the facets it
+  // handles.
+  template <class It> void load(It c) {
+    const float *ccc = c->info().cc;
+    cc_ = {ccc[0], ccc[1], ccc[2]};
+    for (int j = 0; j < 4; ++j) {
+      Vh v = c->vertex(j);
+      const VertexData &d = v->info();
+      CP_[j] = v3(v->point());
+      Cpoles_[j] = {d.pole[0], d.pole[1], d.pole[2]};
+      Cidx_[j] = d.idx;
+      Cinterior_[j] = !detect_ || (d.flags & kVInterior) != 0;
+      if (cocone_ && Cinterior_[j])
+        Cside_[j] = cone_side(cc_ - CP_[j], Cpoles_[j], cr_.sin2_cocone);
+    }
+  }
+
+  // Facet f of the cell loaded, whose dual Voronoi edge runs from its
+  // circumcentre to `other`, or leaves the hull outward when `ray`.
+  void facet(int f, V3 other, bool ray) {
+    // The corners in the order of their vertex numbers: how a cell orders
+    // its vertices depends on the order of insertion, and the rounding of
+    // the tests on the order of the corners; this way a facet gets the same
+    // answer whichever of its cells, and whichever triangulation (one, or a
+    // tile's), reports it.
+    int ci[3] = {(f + 1) % 4, (f + 2) % 4, (f + 3) % 4};
+    auto order = [&](int a, int b) {
+      if (Cidx_[ci[b]] < Cidx_[ci[a]])
+        std::swap(ci[a], ci[b]);
+    };
+    order(0, 1), order(1, 2), order(0, 1);
+    if (own_ && !(*own_)(Cidx_[ci[0]]))
+      return;
+    ++facets_;
+    V3 P[3], poles[3];
+    bool interior[3];
+    int side1[3];
+    uint32_t idx[3];
+    for (int j = 0; j < 3; ++j) {
+      const int i = ci[j];
+      P[j] = CP_[i];
+      poles[j] = Cpoles_[i];
+      idx[j] = Cidx_[i];
+      interior[j] = Cinterior_[i];
+      side1[j] = Cside_[i];
+    }
+    if (ray) {
+      V3 nrm = cross(P[1] - P[0], P[2] - P[0]);
+      V3 o = CP_[f];
+      other = dot(nrm, o - P[0]) > 0 ? -1.0 * nrm : nrm;
+    }
+    if (!check_) {
+      if (is_candidate(cr_, P, poles, interior, side1, cc_, other, ray))
+        tris_.insert(tris_.end(), idx, idx + 3);
+      return;
+    }
+    // Shortcrust mode with its check: the criteria once, at every r near.
+    const int least = near_.least(P, poles, cc_, other, ray);
+    if (least <= kNearR / 2)
+      tris_.insert(tris_.end(), idx, idx + 3);
+    if (least < kNearR)
+      check_->near[least].insert(check_->near[least].end(), idx, idx + 3);
+    if (is_candidate(cocone_cr_, P, poles, interior, side1, cc_, other, ray))
+      check_->cocone.insert(check_->cocone.end(), idx, idx + 3);
+  }
+
+  const Criteria cr_;
+  Criteria cocone_cr_;
+  const NearR near_;
+  const bool detect_, cocone_;
+  const Ownership *own_;
+  std::vector<uint32_t> &tris_;
+  Checks *check_;
+  uint64_t facets_ = 0;
+  V3 cc_{0, 0, 0}, CP_[4], Cpoles_[4];
+  bool Cinterior_[4] = {true, true, true, true};
+  int Cside_[4] = {0, 0, 0, 0};
+  uint32_t Cidx_[4] = {0, 0, 0, 0};
+};
+
+} // namespace
+
+template <class DT>
+void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
+                       const sc_params_t &params, Progress &progress,
+                       std::vector<uint32_t> &tris, sc_diag_t &diag,
+                       const Ownership *own, Checks *check, unsigned threads) {
+  // Room for the candidates (a closed surface has two triangles per
+  // sample, the candidates a few more), and the part of it surely filled
+  // resident at once (prefault.hpp; a tile's triangulation holds its
+  // neighbours' points too, an open scan fewer triangles): growing the
+  // list by doubling touched every page twice, a fault each.
+  const size_t have = tris.size(), nv = dt.number_of_vertices();
+  auto room = [](std::vector<uint32_t> &t, size_t vertices) {
+    const size_t at = t.size();
+    if (t.capacity() < at + 15 * vertices / 2) {
+      t.reserve(at + 15 * vertices / 2);
+      prefault(t.data() + at, 9 * vertices / 2 * sizeof(uint32_t));
+    }
+  };
+  const size_t cells = dt.number_of_cells();
+  // On more threads, the cells in slices of their container, each scanned
+  // on a thread of its own into lists of its own, which are then joined:
+  // the candidates are put in canonical order after, so that the order of
+  // the slices does not show.
+  const size_t slices =
+      own || threads < 2 || cells < kParallelCells ? 1 : 4 * size_t(threads);
+  if (slices == 1) {
+    room(tris, nv);
+    FacetScan<DT> scan(params, own, tris, check);
+    size_t k = 0;
+    for_cells(dt, true, [&](auto c) {
+      progress.tick(k++, cells);
+      scan.cell(c);
+    });
+    for (typename DT::Cell_handle o : infinite)
+      scan.hull(o, dt.infinite_vertex());
+    diag.delaunay_facets += scan.facets();
+    infinite = {};
+    return;
+  }
+  const auto bounds = cell_slices(dt, slices);
+  std::vector<std::vector<uint32_t>> found(slices);
+  std::vector<Checks> checks(check ? slices : 0);
+  std::vector<uint64_t> facets(slices, 0);
+  run_parallel(slices, threads, progress, [&](size_t i, Progress &mine) {
+    room(found[i], nv / slices + 1);
+    FacetScan<DT> scan(params, own, found[i], check ? &checks[i] : nullptr);
+    size_t k = 0;
+    for_cells_in(bounds[i], bounds[i + 1], true, [&](auto c) {
+      mine.tick(k++, cells);
+      if (!c->info().infinite())
+        scan.cell(c);
+    });
+    facets[i] = scan.facets();
+  });
+  FacetScan<DT> scan(params, own, found[0], check ? &checks[0] : nullptr);
+  for (typename DT::Cell_handle o : infinite)
+    scan.hull(o, dt.infinite_vertex());
+  diag.delaunay_facets += scan.facets();
   infinite = {};
+  size_t total = have;
+  for (size_t i = 0; i < slices; ++i) {
+    total += found[i].size();
+    diag.delaunay_facets += facets[i];
+  }
+  tris.reserve(total);
+  for (size_t i = 0; i < slices; ++i) {
+    tris.insert(tris.end(), found[i].begin(), found[i].end());
+    found[i] = {};
+    if (!check)
+      continue;
+    auto join = [](std::vector<uint32_t> &to, std::vector<uint32_t> &from) {
+      to.insert(to.end(), from.begin(), from.end());
+      from = {};
+    };
+    join(check->cocone, checks[i].cocone);
+    for (int r = 0; r < kNearR; ++r)
+      join(check->near[r], checks[i].near[r]);
+  }
 }
 
 template void select_candidates<DtSeq>(DtSeq &,
                                        std::vector<DtSeq::Cell_handle> &,
                                        const sc_params_t &, Progress &,
                                        std::vector<uint32_t> &, sc_diag_t &,
-                                       const Ownership *, Checks *);
+                                       const Ownership *, Checks *, unsigned);
 
 } // namespace dt
 } // namespace sc

@@ -10,6 +10,8 @@
 
 #include "delaunay.hpp"
 
+#include <thread>
+
 #include <CGAL/Spatial_sort_traits_adapter_3.h>
 #include <CGAL/hilbert_sort.h>
 #include <CGAL/spatial_sort.h>
@@ -287,8 +289,11 @@ public:
     seconds[SC_STAGE_POLES] += sw.lap();
 
     progress.stage(SC_STAGE_CANDIDATES);
+    const unsigned threads =
+        params.threads > 0 ? unsigned(params.threads)
+                           : std::max(1u, std::thread::hardware_concurrency());
     select_candidates(dt_, infinite_, params, progress, out.tris, diag, nullptr,
-                      checks(params) ? &out.check : nullptr);
+                      checks(params) ? &out.check : nullptr, threads);
     diag.candidates = out.tris.size() / 3;
     // The unit poles by vertex number, for the normals: copied out last, so
     // that the array takes memory that boundary detection has freed instead

@@ -188,14 +188,13 @@ template <class Ch> V3 hull_normal(Ch c, int inf, V3 *pts) {
 // at higher addresses (what the candidates read): they are scattered over
 // memory, and waiting for each in turn was most of the time of these
 // passes.
-template <class DT, class Visit>
-void for_cells(DT &dt, bool neighbours, Visit &&visit) {
+template <class It, class Visit>
+void for_cells_in(It begin, It end, bool neighbours, Visit &&visit) {
   constexpr int kAhead = 4;
-  const auto end = dt.finite_cells_end();
-  auto ahead = dt.finite_cells_begin();
+  auto ahead = begin;
   for (int i = 0; i < kAhead && ahead != end; ++i)
     ++ahead;
-  for (auto c = dt.finite_cells_begin(); c != end; ++c) {
+  for (auto c = begin; c != end; ++c) {
     if (ahead != end) {
       for (int j = 0; j < 4; ++j) {
         const char *v = reinterpret_cast<const char *>(&*ahead->vertex(j));
@@ -208,6 +207,31 @@ void for_cells(DT &dt, bool neighbours, Visit &&visit) {
     }
     visit(c);
   }
+}
+template <class DT, class Visit>
+void for_cells(DT &dt, bool neighbours, Visit &&visit) {
+  for_cells_in(dt.finite_cells_begin(), dt.finite_cells_end(), neighbours,
+               visit);
+}
+
+// The cells of dt in k slices of about equal shares of its cell container,
+// in the container's order: slice i runs from bounds[i] to bounds[i + 1]
+// (k + 1 bounds, the last the end), each of all the cells, infinite ones
+// too. Found from the container's blocks, without a pass over the cells.
+template <class DT>
+std::vector<typename DT::Cell_iterator> cell_slices(DT &dt, size_t k) {
+  auto &cells = dt.tds().cells();
+  const size_t cap = cells.capacity();
+  std::vector<typename DT::Cell_iterator> bounds;
+  bounds.push_back(cells.begin());
+  for (size_t i = 1; i < k; ++i) {
+    size_t j = cap * i / k;
+    while (j < cap && !cells.is_used(j))
+      ++j;
+    bounds.push_back(j < cap ? cells.iterator_to(cells[j]) : cells.end());
+  }
+  bounds.push_back(cells.end());
+  return bounds;
 }
 
 // Sorts point indices along a Hilbert curve of their points (CGAL's median
@@ -283,12 +307,14 @@ void mark_interior(DT &dt, const std::vector<uint8_t> &state);
 // pass over the Delaunay facets; frees infinite.
 // With own, only the facets the tile owns are tested and counted. With
 // check (shortcrust mode), what its check needs goes there too (section
-// 6.5), not yet in canonical order.
+// 6.5), not yet in canonical order. On `threads` threads (without own),
+// in any order.
 template <class DT>
 void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
                        const sc_params_t &params, Progress &progress,
                        std::vector<uint32_t> &tris, sc_diag_t &diag,
-                       const Ownership *own = nullptr, Checks *check = nullptr);
+                       const Ownership *own = nullptr, Checks *check = nullptr,
+                       unsigned threads = 1);
 
 // A Triangulator (delaunay.cpp) that takes over dt, whose vertices carry
 // input indices (dt is left empty), with the points of rest (input indices)

@@ -252,9 +252,9 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     "0 = never")                                                               \
   X(threads, int, INT, 1, 0, 1024, SC_RANGE_CLOSED, "in [0, 1024]", LOCAL,     \
     'j', "threads", "N",                                                       \
-    "threads for the tiles, the smoothing, watertight mode's labelling and "   \
-    "the noise estimate (a single triangulation runs on one), 0 = one per "    \
-    "core")                                                                    \
+    "threads for the tiles, the smoothing, watertight mode's labelling, the "  \
+    "noise estimate and the candidates (a single triangulation is built on "   \
+    "one), 0 = one per core")                                                  \
   X(tiles, int, INT, 1, 0, 4096, SC_RANGE_CLOSED, "in [0, 4096]", LOCAL, 0,    \
     "tiles", "N",                                                              \
     "split the points into N tiles triangulated apart, on the threads; the "   \

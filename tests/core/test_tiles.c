@@ -12,9 +12,10 @@
  *
  *   test_core_tiles [SCAN.ply ...]
  *   test_core_tiles --quick [CLOSED.ply ...]
- *                  (a small torus on two threads, watertight mode's
- *                   labelling beside the extraction on CLOSED, and the
- *                   cancels: for the ThreadSanitizer build)
+ *                  (a small torus on two threads, one triangulation
+ *                   scanned on two, watertight mode's labelling beside
+ *                   the extraction on CLOSED, and the cancels: for the
+ *                   ThreadSanitizer build)
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -308,6 +309,32 @@ int main(int argc, char **argv) {
     }
     sc_mesh_free(one);
     sc_mesh_free(t);
+    /* One triangulation, its facets scanned on two threads (a sample
+     * large enough for that): the mesh and counts of one thread, in the
+     * modes that test them differently. */
+    {
+      const size_t big = 12000;
+      double *more = malloc(3 * big * sizeof *more);
+      EXPECT_NOT_NULL(more);
+      EXPECT_EQ(
+          scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, big, 9, more),
+          0);
+      const sc_mode_t modes[] = {SC_MODE_COCONE, SC_MODE_SHORTCRUST,
+                                 SC_MODE_BOUNDARY};
+      for (size_t k = 0; k < sizeof modes / sizeof *modes; ++k) {
+        one = run("torus", more, big, modes[k], 1, 1);
+        t = run("torus", more, big, modes[k], 1, 2);
+        char tag[160];
+        snprintf(tag, sizeof tag, "torus, %s, one triangulation on 2 threads",
+                 sc_mode_name(modes[k]));
+        if (one && t && same_output(tag, one, t))
+          printf("ok: %s: %zu triangles, %llu facets\n", tag, t->triangle_count,
+                 (unsigned long long)t->diag.delaunay_facets);
+        sc_mesh_free(one);
+        sc_mesh_free(t);
+      }
+      free(more);
+    }
     for (int a = 2; a < argc; ++a)
       labelling_beside(argv[a]);
     goto cancel;
