@@ -13,7 +13,7 @@ namespace {
 
 // Triangulations of at least so many cells are scanned on more threads,
 // when given them.
-constexpr size_t kParallelCells = 1u << 16;
+constexpr size_t kParallelCells = 1u << 14;
 
 // Where a point of the dual Voronoi edge lies relative to the cocone of a
 // sample: -1 or +1 in one of the two cones around the pole, 0 inside the
