@@ -292,9 +292,12 @@ public:
     const unsigned threads =
         params.threads > 0 ? unsigned(params.threads)
                            : std::max(1u, std::thread::hardware_concurrency());
+    std::vector<std::vector<uint32_t>> later;
     select_candidates(dt_, infinite_, params, progress, out.tris, diag, nullptr,
-                      checks(params) ? &out.check : nullptr, threads);
+                      checks(params) ? &out.check : nullptr, threads, later);
     diag.candidates = out.tris.size() / 3;
+    for (const std::vector<uint32_t> &l : later)
+      diag.candidates += l.size() / 3;
     // The unit poles by vertex number, for the normals: copied out last, so
     // that the array takes memory that boundary detection has freed instead
     // of pages of its own.
@@ -313,6 +316,15 @@ public:
       keep = true;
     if (!keep)
       dt_.clear();
+    // The candidates of the slices scanned on other threads, joined in the
+    // memory the triangulation left.
+    if (!later.empty()) {
+      out.tris.reserve(3 * diag.candidates);
+      for (std::vector<uint32_t> &l : later) {
+        out.tris.insert(out.tris.end(), l.begin(), l.end());
+        l = {};
+      }
+    }
     // Which cell reports a facet, and when, depends on heap addresses; the
     // later stages break ties by the order of the candidates. They carry no
     // orientation: the walk gives them one.

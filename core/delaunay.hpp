@@ -307,14 +307,25 @@ void mark_interior(DT &dt, const std::vector<uint8_t> &state);
 // pass over the Delaunay facets; frees infinite.
 // With own, only the facets the tile owns are tested and counted. With
 // check (shortcrust mode), what its check needs goes there too (section
-// 6.5), not yet in canonical order. On `threads` threads (without own),
-// in any order.
+// 6.5), not yet in canonical order. On `threads` threads (without own,
+// and into an empty tris), in any order, with the rest of the candidates
+// in the lists of `later`, to be joined to tris.
 template <class DT>
 void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
                        const sc_params_t &params, Progress &progress,
                        std::vector<uint32_t> &tris, sc_diag_t &diag,
-                       const Ownership *own = nullptr, Checks *check = nullptr,
-                       unsigned threads = 1);
+                       const Ownership *own, Checks *check, unsigned threads,
+                       std::vector<std::vector<uint32_t>> &later);
+template <class DT>
+void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
+                       const sc_params_t &params, Progress &progress,
+                       std::vector<uint32_t> &tris, sc_diag_t &diag,
+                       const Ownership *own = nullptr,
+                       Checks *check = nullptr) {
+  std::vector<std::vector<uint32_t>> later; // stays empty on one thread
+  select_candidates(dt, infinite, params, progress, tris, diag, own, check, 1,
+                    later);
+}
 
 // A Triangulator (delaunay.cpp) that takes over dt, whose vertices carry
 // input indices (dt is left empty), with the points of rest (input indices)

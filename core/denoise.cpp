@@ -132,8 +132,8 @@ public:
     start_.assign(buckets + 1, 0);
     // Cell coordinates are at most the largest extent over the side,
     // itself at least that extent over n: they fit 32 bits.
-    PrefaultVector<Cell> cells(n);
-    PrefaultVector<uint32_t> bucket(n);
+    MappedVector<Cell> cells(n);
+    MappedVector<uint32_t> bucket(n);
     for (size_t i = 0; i < n; ++i) {
       cells[i] = cell(&xyz[3 * i]);
       bucket[i] = uint32_t(hash(cells[i]));
@@ -151,7 +151,7 @@ public:
     }
     order_.resize(n);
     cells_.resize(n);
-    PrefaultVector<uint32_t> fill(start_.begin(), start_.end() - 1);
+    MappedVector<uint32_t> fill(start_.begin(), start_.end() - 1);
     for (size_t i = 0; i < n; ++i) {
       const uint32_t o = fill[bucket[i]]++;
       order_[o] = uint32_t(i);
@@ -283,8 +283,9 @@ private:
   double lo_[3], side_;
   size_t mask_;
   std::unique_ptr<KdTree> tree_;
-  PrefaultVector<uint32_t> start_, order_;
-  PrefaultVector<Cell> cells_;
+  // (Mapped apart: the estimate may run on a thread of its own.)
+  MappedVector<uint32_t> start_, order_;
+  MappedVector<Cell> cells_;
 };
 static_assert(kEstimateNeighbours <= Neighbours::kMaxK, "too many neighbours");
 

@@ -3,6 +3,7 @@
 #include "prefault.hpp"
 
 #include <cstdint>
+#include <new>
 
 #include <sys/mman.h>
 #include <unistd.h>
@@ -28,3 +29,14 @@ void sc::prefault(void *p, size_t bytes) {
   (void)bytes;
 #endif
 }
+
+void *sc::map_pages(size_t bytes) {
+  void *p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE,
+                 MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (p == MAP_FAILED)
+    throw std::bad_alloc();
+  prefault(p, bytes);
+  return p;
+}
+
+void sc::unmap_pages(void *p, size_t bytes) { (void)munmap(p, bytes); }
