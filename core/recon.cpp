@@ -631,7 +631,10 @@ void Recon::prepare_and_insert(Progress &progress) {
   // A cancel of the caller's, unless the estimate stopped the insertion.
   if (cancelled && !beside.stop.load())
     std::rethrow_exception(cancelled);
-  progress.stage(SC_STAGE_INPUT);
+  // Back to the input stage only to smooth: otherwise the triangulation
+  // stage goes on.
+  if (smooths(noise_))
+    progress.stage(SC_STAGE_INPUT);
   smooth_if_noisy(base, progress);
   const double waited = sw.lap();
   seconds_denoise_ = estimate_seconds + waited;
