@@ -8,6 +8,7 @@
 
 #include "edges.hpp"
 #include "internal.hpp"
+#include "parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -19,6 +20,9 @@ namespace sc {
 namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
+// Small handles: surfaces of at least so many vertices are probed on more
+// threads, when given them.
+constexpr size_t kParallelProbes = 1024;
 // A cut is kept only where it runs mostly along holes: at most this many
 // edges cut for each edge of a hole on the loops it opens (measured: the
 // zippered bunny's handles 0.06 to 2.6, a kitten's tail and a knotted
@@ -384,11 +388,84 @@ int64_t region_twice_genus(const std::vector<uint32_t> &tris,
   return 2 * pieces - chi - loops;
 }
 
+// The region of the triangles within `rings` rings of a vertex, and
+// whether it holds a handle: with its own scratch, so that probes of
+// separate vertices run on separate threads.
+class RingProbe {
+public:
+  RingProbe(const std::vector<uint32_t> &tris,
+            const std::vector<uint32_t> &twin, const VertexStar &star, size_t n,
+            int rings)
+      : tris_(tris), twin_(twin), star_(star), rings_(rings),
+        place_(tris.size() / 3, 0), tri_stamp_(tris.size() / 3, 0),
+        vert_stamp_(n, 0), mark_(n, 0) {}
+
+  // Whether the region about v holds a handle; the region's triangles are
+  // then in region() and its vertices in verts().
+  bool handle_at(uint32_t v) {
+    ++stamp_;
+    region_.clear();
+    verts_.assign(1, v);
+    vert_stamp_[v] = stamp_;
+    front_.assign(1, v);
+    for (int r = 0; r < rings_; ++r) {
+      next_.clear();
+      for (uint32_t u : front_)
+        for (uint32_t k = star_.first[u]; k < star_.first[u + 1]; ++k) {
+          const uint32_t t = star_.tris[k];
+          if (tri_stamp_[t] == stamp_)
+            continue;
+          tri_stamp_[t] = stamp_;
+          place_[t] = uint32_t(region_.size());
+          region_.push_back(t);
+          for (int c = 0; c < 3; ++c) {
+            const uint32_t w = tris_[3 * t + c];
+            if (vert_stamp_[w] != stamp_) {
+              vert_stamp_[w] = stamp_;
+              verts_.push_back(w);
+              next_.push_back(w);
+            }
+          }
+        }
+      front_.swap(next_);
+    }
+    // A disc (Euler characteristic 1) holds no handle, and is what nearly
+    // every region is: counted from the edges to triangles outside it
+    // before anything is sorted. (Its vertices counted once, the
+    // characteristic is at most that of region_twice_genus(), and a
+    // handle in one or two pieces needs it at most 0.)
+    int64_t outside = 0;
+    for (uint32_t t : region_)
+      for (int c = 0; c < 3; ++c)
+        outside += twin_[3 * t + c] == UINT32_MAX ||
+                   tri_stamp_[twin_[3 * t + c] / 3] != stamp_;
+    const int64_t f = int64_t(region_.size());
+    if (2 * int64_t(verts_.size()) - f - outside > 0)
+      return false;
+    return region_twice_genus(
+               tris_, twin_, region_, place_,
+               [&](uint32_t t) { return tri_stamp_[t] == stamp_; }, mark_) >= 2;
+  }
+  const std::vector<uint32_t> &region() const { return region_; }
+  const std::vector<uint32_t> &verts() const { return verts_; }
+
+private:
+  const std::vector<uint32_t> &tris_, &twin_;
+  const VertexStar &star_;
+  const int rings_;
+  // Each triangle's place in the region under way.
+  std::vector<uint32_t> place_, tri_stamp_, vert_stamp_;
+  std::vector<uint8_t> mark_;
+  std::vector<uint32_t> region_, verts_, front_, next_;
+  uint32_t stamp_ = 0;
+};
+
 } // namespace
 
 size_t cut_small_handles(const double *xyz, size_t n,
                          std::vector<uint32_t> &tris, int rings,
-                         size_t max_sites, Progress &progress) {
+                         size_t max_sites, unsigned threads,
+                         Progress &progress) {
   const size_t nt = tris.size() / 3;
   VertexStar star;
   star.build(n, tris, [](size_t) { return true; });
@@ -397,13 +474,25 @@ size_t cut_small_handles(const double *xyz, size_t n,
     EdgeTable table;
     pair_half_edges(n, tris, progress, twin, table);
   }
-  // Each triangle's place in the region under way.
-  std::vector<uint32_t> place(nt, 0);
-  std::vector<uint32_t> tri_stamp(nt, 0), vert_stamp(n, 0);
+  // Every vertex probed first, on the threads, each slice of the vertices
+  // with a probe of its own; then, in the order of the vertices, a region
+  // that holds a handle is a site unless a site before it covers its
+  // vertex. (What a probe finds does not depend on what is covered: the
+  // same sites as probing one vertex after another and skipping those
+  // covered.)
+  std::vector<uint8_t> holds(n, 0);
+  const size_t slices = threads > 1 && n >= kParallelProbes ? threads : 1;
+  run_parallel(slices, threads, progress, [&](size_t i, Progress &mine) {
+    RingProbe probe(tris, twin, star, n, rings);
+    const size_t from = n * i / slices, to = n * (i + 1) / slices;
+    for (size_t v = from; v < to; ++v) {
+      mine.tick(v - from, to - from);
+      holds[v] =
+          star.first[v] != star.first[v + 1] && probe.handle_at(uint32_t(v));
+    }
+  });
+  RingProbe probe(tris, twin, star, n, rings);
   std::vector<uint8_t> covered(n, 0), cut(nt, 0);
-  std::vector<uint32_t> region, verts, front, next;
-  std::vector<uint8_t> mark(n, 0);
-  uint32_t stamp = 0;
   // Each place: its triangles' area, and where its triangles are listed.
   struct Site {
     double area;
@@ -412,53 +501,10 @@ size_t cut_small_handles(const double *xyz, size_t n,
   std::vector<Site> sites;
   std::vector<uint32_t> site_tris;
   for (size_t v = 0; v < n; ++v) {
-    progress.tick(v, n);
-    if (covered[v] || star.first[v] == star.first[v + 1])
+    if (!holds[v] || covered[v])
       continue;
-    ++stamp;
-    region.clear();
-    verts.assign(1, uint32_t(v));
-    vert_stamp[v] = stamp;
-    front.assign(1, uint32_t(v));
-    for (int r = 0; r < rings; ++r) {
-      next.clear();
-      for (uint32_t u : front)
-        for (uint32_t k = star.first[u]; k < star.first[u + 1]; ++k) {
-          const uint32_t t = star.tris[k];
-          if (tri_stamp[t] == stamp)
-            continue;
-          tri_stamp[t] = stamp;
-          place[t] = uint32_t(region.size());
-          region.push_back(t);
-          for (int c = 0; c < 3; ++c) {
-            const uint32_t w = tris[3 * t + c];
-            if (vert_stamp[w] != stamp) {
-              vert_stamp[w] = stamp;
-              verts.push_back(w);
-              next.push_back(w);
-            }
-          }
-        }
-      front.swap(next);
-    }
-    // A disc (Euler characteristic 1) holds no handle, and is what nearly
-    // every region is: counted from the edges to triangles outside it
-    // before anything is sorted. (Its vertices counted once, the
-    // characteristic is at most that of region_twice_genus(), and a
-    // handle in one or two pieces needs it at most 0.)
-    int64_t outside = 0;
-    for (uint32_t t : region)
-      for (int c = 0; c < 3; ++c)
-        outside += twin[3 * t + c] == UINT32_MAX ||
-                   tri_stamp[twin[3 * t + c] / 3] != stamp;
-    const int64_t f = int64_t(region.size());
-    if (2 * int64_t(verts.size()) - f - outside > 0)
-      continue;
-    const int64_t twice_genus = region_twice_genus(
-        tris, twin, region, place,
-        [&](uint32_t t) { return tri_stamp[t] == stamp; }, mark);
-    if (twice_genus < 2)
-      continue;
+    (void)probe.handle_at(uint32_t(v)); // its region again
+    const std::vector<uint32_t> &region = probe.region();
     double area = 0;
     for (uint32_t t : region) {
       double nrm[3];
@@ -467,7 +513,7 @@ size_t cut_small_handles(const double *xyz, size_t n,
     }
     sites.push_back({area, site_tris.size(), site_tris.size() + region.size()});
     site_tris.insert(site_tris.end(), region.begin(), region.end());
-    for (uint32_t w : verts)
+    for (uint32_t w : probe.verts())
       covered[w] = 1;
   }
   if (sites.empty())

@@ -319,10 +319,12 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 // Small handles of a closed, oriented manifold surface (section 11.5):
 // takes out the triangles within `rings` rings of a vertex wherever they
 // hold a handle, the smallest in area first and at most max_sites places;
-// returns how many.
+// returns how many. The vertices are probed on `threads` threads, for the
+// same result.
 size_t cut_small_handles(const double *xyz, size_t n,
                          std::vector<uint32_t> &tris, int rings,
-                         size_t max_sites, Progress &progress);
+                         size_t max_sites, unsigned threads,
+                         Progress &progress);
 // Closes every hole of at most max_loop edges by a least-area patch (sections 9
 // and 11.3; a loop of more than 16 edges is first cut by short chords into
 // pieces), except the loops that boundary (which may be empty) marks as where

@@ -336,8 +336,8 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
       if (!l.ok || l.genus <= bound)
         return;
       std::vector<uint32_t> t = a.tris;
-      const size_t sites = cut_small_handles(lxyz, m, t, rings,
-                                             size_t(l.genus - bound), progress);
+      const size_t sites = cut_small_handles(
+          lxyz, m, t, rings, size_t(l.genus - bound), thread_count(), progress);
       Surface b;
       sc_diag_t db = da;
       if (sites) {

@@ -8,7 +8,8 @@
  * patches must be attached however far the patches' corners lie. The
  * dino at as many random points as it has vertices: the patches break a
  * leg off, and the labelling keeps it but with a small false handle,
- * which must be cut (docs/algorithm.md section 11.5).
+ * which must be cut (docs/algorithm.md section 11.5), and is cut the same
+ * on two threads.
  *
  *   test_core_mesh_sample MESH.ply N SEED MODE [patches]
  *
@@ -63,7 +64,23 @@ int main(int argc, char **argv) {
   char what[512];
   snprintf(what, sizeof what, "%s, %zu random points, %s%s", argv[1], n,
            argv[4], argc == 6 ? " --patches" : "");
-  sc_mesh_free(sct_expect_closed(xyz, n, &p, genus, 1, what));
+  sc_mesh_t *one = sct_expect_closed(xyz, n, &p, genus, 1, what);
+  /* Where small handles were cut, their vertices are probed on more
+   * threads: the same triangles on two. */
+  if (one && one->diag.small_handles_cut > 0) {
+    sc_params_t q = p;
+    q.threads = 2;
+    sc_mesh_t *two = NULL;
+    EXPECT_EQ(sc_reconstruct(xyz, n, &q, &two, msg, sizeof msg), 0);
+    EXPECT(two && two->diag.small_handles_cut == one->diag.small_handles_cut &&
+           two->triangle_count == one->triangle_count &&
+           memcmp(two->triangles, one->triangles,
+                  3 * one->triangle_count * sizeof *one->triangles) == 0);
+    printf("ok: %llu small handles cut, the same triangles on 2 threads\n",
+           (unsigned long long)one->diag.small_handles_cut);
+    sc_mesh_free(two);
+  }
+  sc_mesh_free(one);
   scs_meshcheck_free(&truth);
   free(xyz);
   free(tri);
