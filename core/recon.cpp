@@ -918,10 +918,16 @@ sc_mesh_t *Recon::finish() {
         (closing || params_.mode == SC_MODE_AUTO) && n_ <= kKeepForLabels
             ? kKeepBoundaryShare
             : 0;
-    // On more threads, wherever a boundary sample is found: the labelling
-    // then runs beside the extraction (LabelTask), on it.
+    // On more threads, wherever a boundary sample is found, and always
+    // where it is small: the labelling then runs beside the extraction
+    // (LabelTask), on it, and stops where the patches settle the closure.
+    // (The small ones without a boundary sample that the patches leave in
+    // doubt, such as the cheese, no longer wait for it to be built again:
+    // 4.36 to 2.96-3.40 times CGAL's construction on two threads.)
     if (labels_beside() && !params_.watertight_labels)
       dt_->keep_boundary_share = std::numeric_limits<double>::min();
+    if (labels_beside() && n_ <= kKeepForLabels)
+      dt_->keep = true;
     dt_->filter(work, n_, params_, progress, f, diag, seconds_);
     if (dt_->keep)
       kept_ = std::move(dt_);
@@ -957,7 +963,8 @@ sc_mesh_t *Recon::finish() {
   // Auto mode, on more threads, labels beside the extraction too where it
   // kept the triangulation for a closing (small, a tenth of the samples
   // or more boundary samples): it stops once no closing is needed.
-  if ((labels_beside() && (params_.watertight_labels || !f.boundary.empty())) ||
+  if ((labels_beside() &&
+       (params_.watertight_labels || !f.boundary.empty() || kept_)) ||
       (params_.mode == SC_MODE_AUTO && thread_count() > 1 && kept_))
     labelling_.reset(new LabelTask(std::move(kept_), lxyz.data(), m));
   const sc_diag_t before_prune = diag;
