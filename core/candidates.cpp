@@ -294,46 +294,45 @@ void select_candidates(DT &dt, std::vector<typename DT::Cell_handle> &infinite,
   // On more threads, the cells in slices of their container, each scanned
   // on a thread of its own into lists of its own, which are then joined:
   // the candidates are put in canonical order after, so that the order of
-  // the slices does not show.
+  // the slices does not show. On one, a single slice straight into tris.
   const size_t slices = own || threads < 2 || cells < kParallelCells || have
                             ? 1
                             : 4 * size_t(threads);
-  if (slices == 1) {
-    room(tris, nv);
-    FacetScan<DT> scan(params, own, tris, check);
-    size_t k = 0;
-    for_cells(dt, true, [&](auto c) {
-      progress.tick(k++, cells);
-      scan.cell(c);
-    });
-    for (typename DT::Cell_handle o : infinite)
-      scan.hull(o, dt.infinite_vertex());
-    diag.delaunay_facets += scan.facets();
-    infinite = {};
-    return;
-  }
   const auto bounds = cell_slices(dt, slices);
-  std::vector<std::vector<uint32_t>> found(slices);
-  std::vector<Checks> checks(check ? slices : 0);
+  std::vector<std::vector<uint32_t>> found(slices > 1 ? slices : 0);
+  std::vector<Checks> checks(check && slices > 1 ? slices : 0);
   std::vector<uint64_t> facets(slices, 0);
-  run_parallel(slices, threads, progress, [&](size_t i, Progress &mine) {
-    room(found[i], nv / slices + 1);
-    FacetScan<DT> scan(params, own, found[i], check ? &checks[i] : nullptr);
+  auto out = [&](size_t i) -> std::vector<uint32_t> & {
+    return slices > 1 ? found[i] : tris;
+  };
+  auto check_of = [&](size_t i) {
+    return slices > 1 && check ? &checks[i] : check;
+  };
+  auto scan_slice = [&](size_t i, Progress &p) {
+    room(out(i), nv / slices + 1);
+    FacetScan<DT> scan(params, own, out(i), check_of(i));
     size_t k = 0;
     for_cells_in(bounds[i], bounds[i + 1], true, [&](auto c) {
-      mine.tick(k++, cells);
+      p.tick(k++, cells);
       if (!c->info().infinite())
         scan.cell(c);
     });
     facets[i] = scan.facets();
-  });
-  FacetScan<DT> scan(params, own, found[0], check ? &checks[0] : nullptr);
+  };
+  if (slices == 1)
+    scan_slice(0, progress);
+  else
+    run_parallel(slices, threads, progress, scan_slice);
+  // The hull's facets last, with the first slice.
+  FacetScan<DT> scan(params, own, out(0), check_of(0));
   for (typename DT::Cell_handle o : infinite)
     scan.hull(o, dt.infinite_vertex());
-  diag.delaunay_facets += scan.facets();
+  facets[0] += scan.facets();
   infinite = {};
   for (size_t i = 0; i < slices; ++i)
     diag.delaunay_facets += facets[i];
+  if (slices == 1)
+    return;
   // The first slice's list becomes tris (empty: no tile calls this), the
   // others wait in `later`, for the caller to join once the triangulation
   // is freed: joined here, the whole list would be a second copy of them
