@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <numeric>
 #include <string>
 
@@ -88,13 +89,27 @@ inline Box grown(const Box &b, double d) {
 // changes after construction.
 class PointTree {
 public:
-  PointTree(const double *pts, size_t m) : pts_(pts) {
+  // Built on `threads` threads: the same tree on any number.
+  PointTree(const double *pts, size_t m, unsigned threads, Progress &progress)
+      : pts_(pts) {
     // (Its arrays resident at once: prefault.hpp.)
     reserve_resident(idx_, m);
     idx_.resize(m);
     std::iota(idx_.begin(), idx_.end(), 0u);
-    if (m)
-      build(0, m);
+    std::map<size_t, int32_t> counts;
+    nodes_.resize(m ? size_t(node_count(m, counts)) : 0);
+    if (m) {
+      // The top levels here, the subtrees below them (about four a thread)
+      // on the threads: each writes its own nodes and range of idx_.
+      int depth = 0;
+      while (threads > 1 && (size_t(1) << depth) < 4 * size_t(threads))
+        ++depth;
+      std::vector<Subtree> below;
+      build(0, m, 0, depth, counts, &below);
+      run_parallel(below.size(), threads, progress, [&](size_t i, Progress &) {
+        build(below[i].b, below[i].e, below[i].id, 0, counts, nullptr);
+      });
+    }
     // The points again in the tree's order, so that a leaf's are together.
     reserve_resident(xyz_, 3 * m);
     xyz_.resize(3 * m);
@@ -228,9 +243,35 @@ private:
     int32_t left = -1, right = -1;
   };
 
-  int32_t build(size_t b, size_t e) {
-    const int32_t id = int32_t(nodes_.size());
-    nodes_.push_back(Node());
+  // A subtree left to a thread: points b to e of idx_, root node id.
+  struct Subtree {
+    size_t b, e;
+    int32_t id;
+  };
+
+  // The nodes of the tree of s points (counts remembers, by size: each
+  // level has at most two sizes).
+  static int32_t node_count(size_t s, std::map<size_t, int32_t> &counts) {
+    if (s <= kLeaf)
+      return 1;
+    const auto it = counts.find(s);
+    if (it != counts.end())
+      return it->second;
+    const int32_t c =
+        1 + node_count(s / 2, counts) + node_count(s - s / 2, counts);
+    counts.emplace(s, c);
+    return c;
+  }
+
+  // The subtree of points b to e of idx_, in preorder from node id; `depth`
+  // levels down, with `below`, the subtrees are left there instead. (The
+  // map of counts is only read: every size was counted beforehand.)
+  void build(size_t b, size_t e, int32_t id, int depth,
+             std::map<size_t, int32_t> &counts, std::vector<Subtree> *below) {
+    if (below && depth == 0) {
+      below->push_back({b, e, id});
+      return;
+    }
     Node nd;
     for (int a = 0; a < 3; ++a)
       nd.lo[a] = HUGE_VAL, nd.hi[a] = -HUGE_VAL;
@@ -252,11 +293,12 @@ private:
                          return pts_[3 * size_t(p) + axis] <
                                 pts_[3 * size_t(q) + axis];
                        });
-      nd.left = build(b, mid);
-      nd.right = build(mid, e);
+      nd.left = id + 1;
+      nd.right = id + 1 + node_count(mid - b, counts);
+      build(b, mid, nd.left, depth - 1, counts, below);
+      build(mid, e, nd.right, depth - 1, counts, below);
     }
     nodes_[size_t(id)] = nd;
-    return id;
   }
 
   // The squared distance from c to the box of nd.
@@ -1107,22 +1149,30 @@ struct Numbering {
   std::vector<uint16_t> owner;
 };
 
+// The indices of the n points in Hilbert order (resident at once:
+// prefault.hpp).
+std::vector<uint32_t> hilbert_order(const double *xyz, size_t n) {
+  std::vector<uint32_t> order;
+  reserve_resident(order, n);
+  order.resize(n);
+  std::iota(order.begin(), order.end(), 0u);
+  hilbert_sort(xyz, order);
+  return order;
+}
+
 // The vertex numbering of the single triangulation (its Hilbert order of
 // all the points, the first of equal points standing for them), from
 // is_vertex (freed) and out.dups: out.to_input, and the counts of diag
-// that it gives.
+// that it gives. The Hilbert order may come made (`sorted`, freed).
 Numbering number_points(const double *xyz, size_t n,
                         std::vector<uint8_t> &is_vertex,
                         const std::vector<Tile> *ts, Filtered &out,
-                        sc_diag_t &diag) {
+                        sc_diag_t &diag, std::vector<uint32_t> &&sorted = {}) {
   Numbering num;
   {
-    // (The arrays resident at once: prefault.hpp.)
-    std::vector<uint32_t> order;
-    reserve_resident(order, n);
-    order.resize(n);
-    std::iota(order.begin(), order.end(), 0u);
-    hilbert_sort(xyz, order);
+    const std::vector<uint32_t> order =
+        sorted.size() == n ? std::move(sorted) : hilbert_order(xyz, n);
+    sorted = {};
     out.to_input.clear();
     reserve_resident(out.to_input, n);
     for (uint32_t i : order)
@@ -1268,11 +1318,17 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
   // Within a memory limit no triangulation is kept between phases: a sort
   // tells them.
   std::vector<uint8_t> is_vertex(n, 0);
+  std::vector<uint32_t> sorted;
   if (bounded) {
     distinct_points(xyz, n, is_vertex, out.dups);
   } else {
-    run_parallel(k, threads, progress, [&](size_t i, Progress &p) {
-      triangulate_own(xyz, ts[i], p);
+    // The Hilbert order of all the points, which numbers the vertices,
+    // is sorted beside the tiles: it reads only the points.
+    run_parallel(k + 1, threads, progress, [&](size_t i, Progress &p) {
+      if (i == 0)
+        sorted = hilbert_order(xyz, n);
+      else
+        triangulate_own(xyz, ts[i - 1], p);
     });
     for (Tile &t : ts) {
       for (auto v = t.dt.finite_vertices_begin();
@@ -1282,13 +1338,14 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
       t.dups = {};
     }
   }
-  const Numbering num = number_points(xyz, n, is_vertex, &ts, out, diag);
+  const Numbering num =
+      number_points(xyz, n, is_vertex, &ts, out, diag, std::move(sorted));
   const std::vector<uint32_t> &rank = num.rank;
   const std::vector<double> &pts = num.pts;
   const std::vector<uint16_t> &owner = num.owner;
   const size_t m = out.to_input.size();
 
-  const PointTree tree(pts.data(), m);
+  const PointTree tree(pts.data(), m, threads, progress);
   const Shared shared{pts.data(), owner.data(), &tree};
 
   // Phase 2: each tile numbered as the single triangulation, grown by the
@@ -1468,7 +1525,7 @@ bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
   for (Tile &other : ts)
     other.own = {};
   num.rank = {};
-  const PointTree tree(pts.data(), m);
+  const PointTree tree(pts.data(), m, 1, progress);
   const Shared shared{pts.data(), owner.data(), &tree};
   triangulate_vertices(pts.data(), mine, t, progress);
   mine = {};
