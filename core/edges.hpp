@@ -10,6 +10,7 @@
 #define SC_CORE_EDGES_HPP
 
 #include "internal.hpp"
+#include "parallel.hpp"
 #include "prefault.hpp"
 
 #include <algorithm>
@@ -76,11 +77,11 @@ template <class T> struct Pool {
   std::vector<T> take() {
     if (spare.empty())
       return {};
-    auto best = std::max_element(spare.begin(), spare.end(),
-                                 [](const std::vector<T> &a,
-                                    const std::vector<T> &b) {
-                                   return a.capacity() < b.capacity();
-                                 });
+    auto best =
+        std::max_element(spare.begin(), spare.end(),
+                         [](const std::vector<T> &a, const std::vector<T> &b) {
+                           return a.capacity() < b.capacity();
+                         });
     std::vector<T> v = std::move(*best);
     spare.erase(best);
     v.clear();
@@ -95,6 +96,10 @@ template <class T> struct Pool {
 // (edges.cpp).
 extern thread_local Pool<uint32_t> u32_pool;
 
+// Edge tables of fewer triangles than this are built on one thread
+// whatever the threads (EdgeTable::build()).
+constexpr size_t kParallelTriangles = 16384;
+
 // Every candidate edge with its triangles in the cyclic order in which they
 // appear when rotating about the edge, right-handed about the direction from
 // its smaller to its larger vertex index.
@@ -108,8 +113,8 @@ struct EdgeTable {
     Entry() {}
     Entry(uint64_t k, uint32_t t, uint8_t c) : key(k), tri(t), corner(c) {}
   };
-  std::vector<Entry> entries;   // grouped by edge, each group by angle
-  std::vector<uint32_t> first;  // edge id -> first entry; one extra at end
+  std::vector<Entry> entries;  // grouped by edge, each group by angle
+  std::vector<uint32_t> first; // edge id -> first entry; one extra at end
   // 3 per triangle: edge (v[k], v[k+1]). Only pruning and the walk find
   // edges by triangle: tables built without angles, or appended to, leave
   // it empty, and so does keep_live() unless asked (filling it was a
@@ -139,8 +144,24 @@ struct EdgeTable {
   // and their triangles, and it saves a frame per edge. (With them, an edge
   // of a single triangle has angle 0 too, for nothing compares it, and an
   // edge of two has angles 0 and 0 or 2 quarters: see below.)
+  // On `threads` threads, the buckets' sorts and the angles run in slices:
+  // the same table on any number.
   void build(const double *xyz, size_t n, const std::vector<uint32_t> &tris,
-             Progress &progress, bool angles = true) {
+             Progress &progress, bool angles = true, unsigned threads = 1) {
+    // Slices [b, e) of count, about four a thread where it pays.
+    auto sliced = [&](size_t count, double at, auto &&body) {
+      if (threads < 2 || tris.size() < 3 * kParallelTriangles) {
+        body(size_t(0), count);
+        return;
+      }
+      const size_t k = 4 * size_t(threads);
+      run_parallel(
+          k, threads, progress,
+          [&](size_t i, Progress &) {
+            body(count * i / k, count * (i + 1) / k);
+          },
+          at, at);
+    };
     const size_t nt = tris.size() / 3;
     // Bucket the entries by their smaller vertex (a counting sort), then
     // sort each small bucket: linear overall, unlike one global sort.
@@ -165,9 +186,12 @@ struct EdgeTable {
     // A bucket holds a vertex's edges, filled in triangle order: a stable
     // sort by key alone, which keeps that order among the triangles of an
     // edge, sorts it by (key, triangle).
-    for (size_t v = 0; v < n; ++v)
-      sort_bucket(entries.data() + count[v], count[v + 1] - count[v],
-                  [](const Entry &x, const Entry &y) { return x.key < y.key; });
+    sliced(n, 0.5, [&](size_t b, size_t e) {
+      for (size_t v = b; v < e; ++v)
+        sort_bucket(
+            entries.data() + count[v], count[v + 1] - count[v],
+            [](const Entry &x, const Entry &y) { return x.key < y.key; });
+    });
     index_edges(nt, &progress, angles);
     angle.clear();
     if (!angles)
@@ -175,45 +199,52 @@ struct EdgeTable {
     reserve_resident(angle, entries.size());
     angle.resize(entries.size());
     // Each edge's frame once, then its triangles by angle (ties by number).
-    for (size_t e = 0; e + 1 < first.size(); ++e) {
-      Entry *x = &entries[first[e]];
-      double *ang = &angle[first[e]];
-      const uint32_t k = first[e + 1] - first[e];
-      if (k < 2) {
-        ang[0] = 0;
-        continue;
-      }
-      if (k == 2) {
-        // Two triangles are in either order about their edge, and all
-        // that is asked of their angles is whether they are less than a
-        // right angle apart (is_sharp()): angles 0 and 0 if they are, 0
-        // and a half turn if not. The sign of the dot product of the two
-        // triangles' directions across the edge tells, without an atan2.
-        const double *a = xyz + 3 * size_t(key_lo(x->key)),
-                     *b = xyz + 3 * size_t(uint32_t(x->key));
-        const double *p = xyz + 3 * size_t(third(tris, x[0])),
-                     *q = xyz + 3 * size_t(third(tris, x[1]));
-        double u[3], w1[3], w2[3];
-        for (int j = 0; j < 3; ++j)
-          u[j] = b[j] - a[j], w1[j] = p[j] - a[j], w2[j] = q[j] - a[j];
-        const double across =
-            dot3(w1, w2) * dot3(u, u) - dot3(w1, u) * dot3(w2, u);
-        ang[0] = 0;
-        ang[1] = across > 0 ? 0.0 : 2.0;
-        continue;
-      }
-      const Frame f(xyz, key_lo(x->key), uint32_t(x->key));
-      for (uint32_t i = 0; i < k; ++i)
-        ang[i] = f.quarters(xyz, third(tris, x[i]));
-      for (uint32_t i = 1; i < k; ++i)
-        for (uint32_t j = i;
-             j > 0 && (ang[j] < ang[j - 1] ||
-                       (ang[j] == ang[j - 1] && x[j].tri < x[j - 1].tri));
-             --j) {
-          std::swap(x[j], x[j - 1]);
-          std::swap(ang[j], ang[j - 1]);
-        }
+    sliced(edges(), 1.0, [&](size_t b, size_t end) {
+      for (size_t e = b; e < end; ++e)
+        sort_by_angle(xyz, tris, e);
+    });
+  }
+
+  // The angles of the triangles of edge e, which build() sorts them by.
+  void sort_by_angle(const double *xyz, const std::vector<uint32_t> &tris,
+                     size_t e) {
+    Entry *x = &entries[first[e]];
+    double *ang = &angle[first[e]];
+    const uint32_t k = first[e + 1] - first[e];
+    if (k < 2) {
+      ang[0] = 0;
+      return;
     }
+    if (k == 2) {
+      // Two triangles are in either order about their edge, and all
+      // that is asked of their angles is whether they are less than a
+      // right angle apart (is_sharp()): angles 0 and 0 if they are, 0
+      // and a half turn if not. The sign of the dot product of the two
+      // triangles' directions across the edge tells, without an atan2.
+      const double *a = xyz + 3 * size_t(key_lo(x->key)),
+                   *b = xyz + 3 * size_t(uint32_t(x->key));
+      const double *p = xyz + 3 * size_t(third(tris, x[0])),
+                   *q = xyz + 3 * size_t(third(tris, x[1]));
+      double u[3], w1[3], w2[3];
+      for (int j = 0; j < 3; ++j)
+        u[j] = b[j] - a[j], w1[j] = p[j] - a[j], w2[j] = q[j] - a[j];
+      const double across =
+          dot3(w1, w2) * dot3(u, u) - dot3(w1, u) * dot3(w2, u);
+      ang[0] = 0;
+      ang[1] = across > 0 ? 0.0 : 2.0;
+      return;
+    }
+    const Frame f(xyz, key_lo(x->key), uint32_t(x->key));
+    for (uint32_t i = 0; i < k; ++i)
+      ang[i] = f.quarters(xyz, third(tris, x[i]));
+    for (uint32_t i = 1; i < k; ++i)
+      for (uint32_t j = i;
+           j > 0 && (ang[j] < ang[j - 1] ||
+                     (ang[j] == ang[j - 1] && x[j].tri < x[j - 1].tri));
+           --j) {
+        std::swap(x[j], x[j - 1]);
+        std::swap(ang[j], ang[j - 1]);
+      }
   }
 
   // Keeps only the entries of triangles with alive[t] set, renumbered in
@@ -259,8 +290,7 @@ struct EdgeTable {
     if (first_new >= nt)
       return;
     angle = std::vector<double>();
-    const std::vector<uint32_t> added(tris.begin() + 3 * first_new,
-                                      tris.end());
+    const std::vector<uint32_t> added(tris.begin() + 3 * first_new, tris.end());
     EdgeTable more;
     more.build(nullptr, n, added, progress, false);
     size_t i = entries.size(), j = more.entries.size();

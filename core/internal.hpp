@@ -230,11 +230,11 @@ EdgeTablePtr new_edge_table();
 void release_scratch();
 // Sharp-edge pruning (section 7). keep_vertex, when not empty, marks the
 // vertices at which no edge is ever sharp (boundary samples). Leaves the
-// candidates' edge table in `table`.
+// candidates' edge table in `table`, built on `threads` threads.
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
            bool erode_single, const std::vector<uint8_t> &keep_vertex,
-           std::vector<uint8_t> &alive, EdgeTablePtr &table,
-           Progress &progress, sc_diag_t &diag);
+           std::vector<uint8_t> &alive, EdgeTablePtr &table, Progress &progress,
+           sc_diag_t &diag, unsigned threads = 1);
 // The walk and small holes (sections 8 and 9). Takes the table prune()
 // left for the same candidates and alive flags. Holes mostly rimmed by
 // samples marked in boundary are left open. The walk takes the flattest

@@ -40,11 +40,11 @@ bool is_sharp(const EdgeTable &et, uint32_t e,
 
 void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
            bool erode_single, const std::vector<uint8_t> &keep_vertex,
-           std::vector<uint8_t> &alive, EdgeTablePtr &table,
-           Progress &progress, sc_diag_t &diag) {
+           std::vector<uint8_t> &alive, EdgeTablePtr &table, Progress &progress,
+           sc_diag_t &diag, unsigned threads) {
   table.reset(new EdgeTable);
   EdgeTable &et = *table;
-  et.build(xyz, n, cand, progress);
+  et.build(xyz, n, cand, progress, true, threads);
   const size_t ne = et.edges();
   alive.assign(cand.size() / 3, 1);
   std::vector<uint32_t> work(ne);

@@ -971,7 +971,7 @@ sc_mesh_t *Recon::finish() {
   std::vector<uint8_t> alive;
   EdgeTablePtr table;
   prune(lxyz.data(), m, f.tris, params_.paper_pruning != 0, f.boundary, alive,
-        table, progress, diag);
+        table, progress, diag, thread_count());
   seconds_[SC_STAGE_PRUNE] += sw.lap();
 
   progress.stage(SC_STAGE_EXTRACT);
@@ -1097,7 +1097,7 @@ void Recon::check_topology(const double *lxyz, size_t m, Filtered &f,
     EdgeTablePtr table;
     d.candidates = cand.size() / 3;
     prune(lxyz, m, cand, params_.paper_pruning != 0, f.boundary, alive, table,
-          progress, d);
+          progress, d, thread_count());
     extract(lxyz, m, cand, alive, std::move(table),
             size_t(params_.max_hole_edges), f.boundary, progress, s, d);
   };
