@@ -148,19 +148,10 @@ struct EdgeTable {
   // the same table on any number.
   void build(const double *xyz, size_t n, const std::vector<uint32_t> &tris,
              Progress &progress, bool angles = true, unsigned threads = 1) {
-    // Slices [b, e) of count, about four a thread where it pays.
+    // (Slices, where it pays: see kParallelTriangles.)
+    const bool parallel = tris.size() >= 3 * kParallelTriangles;
     auto sliced = [&](size_t count, double at, auto &&body) {
-      if (threads < 2 || tris.size() < 3 * kParallelTriangles) {
-        body(size_t(0), count);
-        return;
-      }
-      const size_t k = 4 * size_t(threads);
-      run_parallel(
-          k, threads, progress,
-          [&](size_t i, Progress &) {
-            body(count * i / k, count * (i + 1) / k);
-          },
-          at, at);
+      run_sliced(count, threads, parallel, progress, body, at);
     };
     const size_t nt = tris.size() / 3;
     // Bucket the entries by their smaller vertex (a counting sort), then

@@ -86,6 +86,25 @@ void run_parallel(size_t k, unsigned threads, Progress &progress, F &&fn,
     std::rethrow_exception(error);
 }
 
+// Runs body(b, e) over slices [b, e) that cover [0, count): one slice
+// where `parallel` is false or there is one thread, else about four a
+// thread, run as run_parallel() runs them (progress stays at `at`). body
+// must not touch what another slice writes; the result then does not
+// depend on the threads.
+template <class F>
+void run_sliced(size_t count, unsigned threads, bool parallel,
+                Progress &progress, F &&body, double at) {
+  if (threads < 2 || !parallel) {
+    body(size_t(0), count);
+    return;
+  }
+  const size_t k = 4 * size_t(threads);
+  run_parallel(
+      k, threads, progress,
+      [&](size_t i, Progress &) { body(count * i / k, count * (i + 1) / k); },
+      at, at);
+}
+
 } // namespace sc
 
 #endif
