@@ -1227,13 +1227,17 @@ std::vector<uint32_t> own_vertices(Tile &t, const std::vector<uint32_t> &rank) {
   return mine;
 }
 
-// The foreign points in t's reach, by vertex number, ascending.
-std::vector<uint32_t> in_reach(const Tile &t, const std::vector<double> &pts,
-                               const std::vector<uint16_t> &owner) {
+// The foreign points in t's reach, by vertex number, ascending: from the
+// tree, so that a tile reads the points near it, not all of them.
+std::vector<uint32_t> in_reach(const Shared &s, const Tile &t) {
   std::vector<uint32_t> add;
-  for (size_t v = 0; v < owner.size(); ++v)
-    if (owner[v] != t.id && in_box(t.reach, &pts[3 * v]))
-      add.push_back(uint32_t(v));
+  const double none_lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+               none_hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  s.tree->in_box(t.reach.lo, t.reach.hi, none_lo, none_hi, [&](uint32_t v) {
+    if (s.owner[v] != t.id)
+      add.push_back(v);
+  });
+  std::sort(add.begin(), add.end());
   return add;
 }
 
@@ -1242,11 +1246,10 @@ std::vector<uint32_t> in_reach(const Tile &t, const std::vector<double> &pts,
 // one ring more). False, having certified nothing, when the tile spans no
 // volume; with give_up, NotTileable when the tile takes in too many
 // (certify()).
-bool grow_tile(const Shared &s, Tile &t, const std::vector<double> &pts,
-               const std::vector<uint16_t> &owner, bool ring, bool give_up,
+bool grow_tile(const Shared &s, Tile &t, size_t m, bool ring, bool give_up,
                Progress &progress) {
-  t.member.assign(owner.size(), false);
-  (void)insert_foreign(s, t, in_reach(t, pts, owner), progress);
+  t.member.assign(m, false);
+  (void)insert_foreign(s, t, in_reach(s, t), progress);
   if (t.dt.dimension() < 3)
     return false;
   certify(s, t, progress, ring, give_up);
@@ -1364,7 +1367,7 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
         v->info() = VertexData(rank[v->info().idx]);
       t.numbered = true;
     }
-    if (grow_tile(shared, t, pts, owner, false, give_up, p))
+    if (grow_tile(shared, t, m, false, give_up, p))
       return true;
     flat = 1;
     return false;
@@ -1529,7 +1532,7 @@ bool tile_job(const double *xyz, size_t n, size_t tiles, size_t index,
   const Shared shared{pts.data(), owner.data(), &tree};
   triangulate_vertices(pts.data(), mine, t, progress);
   mine = {};
-  if (!grow_tile(shared, t, pts, owner, true, false, progress))
+  if (!grow_tile(shared, t, m, true, false, progress))
     return false;
   seconds[SC_STAGE_DELAUNAY] += sw.lap();
 
