@@ -318,13 +318,15 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                    Progress &progress, EdgeTable &table);
 // Small handles of a closed, oriented manifold surface (section 11.5):
 // takes out the triangles within `rings` rings of a vertex wherever they
-// hold a handle, the smallest in area first and at most max_sites places;
-// returns how many. The vertices are probed on `threads` threads, for the
-// same result.
+// hold a handle, or a tunnel (a thin tube that the extracted surface does
+// not have: its triangles mostly without `supported` set, and cutting it
+// leaves its sides joined), the smallest in area first and at most
+// max_sites places; returns how many. The vertices are probed on
+// `threads` threads, for the same result.
 size_t cut_small_handles(const double *xyz, size_t n,
                          std::vector<uint32_t> &tris, int rings,
-                         size_t max_sites, unsigned threads,
-                         Progress &progress);
+                         size_t max_sites, const double *poles,
+                         unsigned threads, Progress &progress);
 // Closes every hole of at most max_loop edges by a least-area patch (sections 9
 // and 11.3; a loop of more than 16 edges is first cut by short chords into
 // pieces), except the loops that boundary (which may be empty) marks as where
@@ -486,6 +488,9 @@ private:
   // round holes of the scan when `cut`.
   void close_surface(const double *lxyz, size_t m, bool cut,
                      Progress &progress, Surface &surf, sc_diag_t &diag);
+  // The poles of the vertices, by vertex number, while finish() closes the
+  // surface (close_surface() tells the labelling's tunnels by them).
+  const double *closing_poles_ = nullptr;
   void patch_surface(const double *lxyz, size_t m, bool cut, Progress &progress,
                      Surface &surf, sc_diag_t &diag);
   // Shortcrust mode's check (section 6.5): the cocone test's surface,

@@ -329,35 +329,43 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     if (!p.ok)
       return;
     const int64_t bound = p.genus + int64_t(diag.handles_cut);
-    int rings = kSmallHandleRings;
-    for (int round = 0;
-         round < kSmallHandleRounds && rings <= kSmallHandleRingsMax; ++round) {
-      const Closure l(da);
-      if (!l.ok || l.genus <= bound)
+    // The handles first, then the tunnels (where the poles are known),
+    // each in rounds of their own.
+    for (const bool tunnels : {false, true}) {
+      if (tunnels && !closing_poles_)
         return;
-      std::vector<uint32_t> t = a.tris;
-      const size_t sites = cut_small_handles(
-          lxyz, m, t, rings, size_t(l.genus - bound), thread_count(), progress);
-      Surface b;
-      sc_diag_t db = da;
-      if (sites) {
-        fill_holes(lxyz, m, t, kMaxFillLoop, {}, progress, db, kMaxFillWork);
-        describe_manifold(t, b, db);
-        // A cut across a thin part can split a small piece off: a pocket,
-        // which goes as the pockets of the closing do (below).
-        if (db.components > l.components)
-          drop_small_closed(lxyz, m, b, b.tris.size() / 3 / 100, false,
-                            progress, db);
+      int rings = kSmallHandleRings;
+      for (int round = 0;
+           round < kSmallHandleRounds && rings <= kSmallHandleRingsMax;
+           ++round) {
+        const Closure l(da);
+        if (!l.ok || l.genus <= bound)
+          return;
+        std::vector<uint32_t> t = a.tris;
+        const size_t sites = cut_small_handles(
+            lxyz, m, t, rings, size_t(l.genus - bound),
+            tunnels ? closing_poles_ : nullptr, thread_count(), progress);
+        Surface b;
+        sc_diag_t db = da;
+        if (sites) {
+          fill_holes(lxyz, m, t, kMaxFillLoop, {}, progress, db, kMaxFillWork);
+          describe_manifold(t, b, db);
+          // A cut across a thin part can split a small piece off: a pocket,
+          // which goes as the pockets of the closing do (below).
+          if (db.components > l.components)
+            drop_small_closed(lxyz, m, b, b.tris.size() / 3 / 100, false,
+                              progress, db);
+        }
+        const Closure c(db);
+        if (!sites || !c.ok || c.loops > 0 || c.components > l.components ||
+            c.genus >= l.genus || c.genus < bound) {
+          ++rings;
+          continue;
+        }
+        db.small_handles_cut = da.small_handles_cut + sites;
+        a = std::move(b);
+        da = db;
       }
-      const Closure c(db);
-      if (!sites || !c.ok || c.loops > 0 || c.components > l.components ||
-          c.genus >= l.genus || c.genus < bound) {
-        ++rings;
-        continue;
-      }
-      db.small_handles_cut = da.small_handles_cut + sites;
-      a = std::move(b);
-      da = db;
     }
   };
 
@@ -975,6 +983,7 @@ sc_mesh_t *Recon::finish() {
   seconds_[SC_STAGE_PRUNE] += sw.lap();
 
   progress.stage(SC_STAGE_EXTRACT);
+  closing_poles_ = f.poles.data();
   Surface surf;
   // Watertight mode cuts the handles that closed round holes of the scan
   // and then closes every hole, so nothing is filled before that. Where
@@ -1043,6 +1052,7 @@ sc_mesh_t *Recon::finish() {
   else if (params_.mode == SC_MODE_SHORTCRUST && !f.check.cocone.empty())
     check_topology(lxyz.data(), m, f, before_prune, progress, surf, diag);
 
+  closing_poles_ = nullptr;
   std::vector<double> acc = vertex_normals(lxyz, m, surf.tris, f.poles);
   // Back to input indices.
   lxyz = std::vector<double>();

@@ -9,7 +9,9 @@
  * dino at as many random points as it has vertices: the patches break a
  * leg off, and the labelling keeps it but with a small false handle,
  * which must be cut (docs/algorithm.md section 11.5), and is cut the same
- * on two threads.
+ * on two threads. The anchor at as many random points as it has vertices:
+ * the labelling keeps its four true holes, two of them small, and makes
+ * tunnels beside them, which must be cut while the holes stay.
  *
  *   test_core_mesh_sample MESH.ply N SEED MODE [patches]
  *
