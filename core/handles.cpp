@@ -515,8 +515,7 @@ size_t cut_small_handles(const double *xyz, size_t n,
     }
   });
   RingProbe probe(tris, twin, star, n, rings);
-  // Handles cover their regions' vertices against other handles, tubes
-  // against other tubes and handles.
+  // A site covers its region's vertices: no site after it starts there.
   std::vector<uint8_t> covered(n, 0), cut(nt, 0);
   // Each place: its triangles' area, where its triangles are listed, and
   // for a tube, the triangles outside it across its two loops.

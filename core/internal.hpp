@@ -318,9 +318,9 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
                    Progress &progress, EdgeTable &table);
 // Small handles of a closed, oriented manifold surface (section 11.5):
 // takes out the triangles within `rings` rings of a vertex wherever they
-// hold a handle, or a tunnel (a thin tube that the extracted surface does
-// not have: its triangles mostly without `supported` set, and cutting it
-// leaves its sides joined), the smallest in area first and at most
+// hold a handle, or with `poles` (by vertex), a tunnel instead: an annulus
+// that faces its axis, lies at an angle to its corners' poles, and whose
+// cut leaves its two sides joined; the smallest in area first and at most
 // max_sites places; returns how many. The vertices are probed on
 // `threads` threads, for the same result.
 size_t cut_small_handles(const double *xyz, size_t n,
