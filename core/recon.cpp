@@ -983,6 +983,11 @@ sc_mesh_t *Recon::finish() {
   seconds_[SC_STAGE_PRUNE] += sw.lap();
 
   progress.stage(SC_STAGE_EXTRACT);
+  // (Forgotten once the surface is closed, whatever happens.)
+  struct ForgetPoles {
+    const double *&poles;
+    ~ForgetPoles() { poles = nullptr; }
+  } forget_poles{closing_poles_};
   closing_poles_ = f.poles.data();
   Surface surf;
   // Watertight mode cuts the handles that closed round holes of the scan
@@ -1052,7 +1057,6 @@ sc_mesh_t *Recon::finish() {
   else if (params_.mode == SC_MODE_SHORTCRUST && !f.check.cocone.empty())
     check_topology(lxyz.data(), m, f, before_prune, progress, surf, diag);
 
-  closing_poles_ = nullptr;
   std::vector<double> acc = vertex_normals(lxyz, m, surf.tris, f.poles);
   // Back to input indices.
   lxyz = std::vector<double>();
