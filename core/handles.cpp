@@ -487,7 +487,8 @@ private:
 size_t cut_small_handles(const double *xyz, size_t n,
                          std::vector<uint32_t> &tris, int rings,
                          size_t max_sites, const double *poles,
-                         unsigned threads, Progress &progress) {
+                         const std::vector<uint8_t> *only, unsigned threads,
+                         Progress &progress) {
   const size_t nt = tris.size() / 3;
   VertexStar star;
   star.build(n, tris, [](size_t) { return true; });
@@ -509,9 +510,10 @@ size_t cut_small_handles(const double *xyz, size_t n,
     const size_t from = n * i / slices, to = n * (i + 1) / slices;
     for (size_t v = from; v < to; ++v) {
       mine.tick(v - from, to - from);
-      holds[v] = star.first[v] != star.first[v + 1]
-                     ? probe.handle_at(uint32_t(v))
-                     : uint8_t(kNothing);
+      holds[v] =
+          star.first[v] != star.first[v + 1] && (!poles || (only && (*only)[v]))
+              ? probe.handle_at(uint32_t(v))
+              : uint8_t(kNothing);
     }
   });
   RingProbe probe(tris, twin, star, n, rings);

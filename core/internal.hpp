@@ -326,7 +326,8 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 size_t cut_small_handles(const double *xyz, size_t n,
                          std::vector<uint32_t> &tris, int rings,
                          size_t max_sites, const double *poles,
-                         unsigned threads, Progress &progress);
+                         const std::vector<uint8_t> *only, unsigned threads,
+                         Progress &progress);
 // Closes every hole of at most max_loop edges by a least-area patch (sections 9
 // and 11.3; a loop of more than 16 edges is first cut by short chords into
 // pieces), except the loops that boundary (which may be empty) marks as where

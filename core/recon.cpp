@@ -7,6 +7,7 @@
 #include "internal.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <climits>
 #include <cmath>
@@ -109,6 +110,14 @@ struct Closure {
     return genus < o.genus;
   }
 };
+
+// The corners of triangle k of tris, in increasing order.
+inline std::array<uint32_t, 3> sorted_corners(const std::vector<uint32_t> &tris,
+                                              size_t k) {
+  std::array<uint32_t, 3> c = {tris[3 * k], tris[3 * k + 1], tris[3 * k + 2]};
+  std::sort(c.begin(), c.end());
+  return c;
+}
 
 } // namespace
 
@@ -342,9 +351,25 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
         if (!l.ok || l.genus <= bound)
           return;
         std::vector<uint32_t> t = a.tris;
+        // A tunnel's wall is the labelling's own: only the vertices of its
+        // triangles that the patches' closure lacks are looked at.
+        std::vector<uint8_t> only;
+        if (tunnels) {
+          std::vector<std::array<uint32_t, 3>> theirs(surf.tris.size() / 3);
+          for (size_t k = 0; k < theirs.size(); ++k)
+            theirs[k] = sorted_corners(surf.tris, k);
+          std::sort(theirs.begin(), theirs.end());
+          only.assign(m, 0);
+          for (size_t k = 0; k < t.size() / 3; ++k)
+            if (!std::binary_search(theirs.begin(), theirs.end(),
+                                    sorted_corners(t, k)))
+              for (int c = 0; c < 3; ++c)
+                only[t[3 * k + c]] = 1;
+        }
         const size_t sites = cut_small_handles(
             lxyz, m, t, rings, size_t(l.genus - bound),
-            tunnels ? closing_poles_ : nullptr, thread_count(), progress);
+            tunnels ? closing_poles_ : nullptr, tunnels ? &only : nullptr,
+            thread_count(), progress);
         Surface b;
         sc_diag_t db = da;
         if (sites) {
