@@ -46,6 +46,15 @@ void hilbert_sort(const double *xyz, std::vector<uint32_t> &idx) {
                          XyzMap{xyz}));
 }
 
+std::vector<uint32_t> hilbert_order(const double *xyz, size_t n) {
+  std::vector<uint32_t> order;
+  reserve_resident(order, n);
+  order.resize(n);
+  std::iota(order.begin(), order.end(), 0u);
+  hilbert_sort(xyz, order);
+  return order;
+}
+
 namespace {
 
 // The round of point i in a biased randomized insertion order: r with
@@ -350,13 +359,10 @@ private:
   void number_vertices(const double *xyz, size_t n,
                        std::vector<uint32_t> &to_input) {
     std::vector<uint32_t> order;
-    if (hilbert_.size() == n) {
+    if (hilbert_.size() == n)
       order.swap(hilbert_);
-    } else {
-      order.resize(n);
-      std::iota(order.begin(), order.end(), 0u);
-      hilbert_sort(xyz, order);
-    }
+    else
+      order = hilbert_order(xyz, n);
     hilbert_ = {};
     std::vector<uint8_t> is_vertex(n, 0);
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();

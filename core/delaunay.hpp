@@ -237,6 +237,9 @@ std::vector<typename DT::Cell_iterator> cell_slices(DT &dt, size_t k) {
 // Sorts point indices along a Hilbert curve of their points (CGAL's median
 // policy).
 void hilbert_sort(const double *xyz, std::vector<uint32_t> &idx);
+// The indices 0 .. n-1 of the points in Hilbert order (resident at once:
+// prefault.hpp).
+std::vector<uint32_t> hilbert_order(const double *xyz, size_t n);
 // A biased randomized insertion order (Amenta, Choi and Rote) drawn from a
 // Hilbert order of the indices: rounds, each a quarter of the size of the
 // next, each in Hilbert order (delaunay.cpp).

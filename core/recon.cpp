@@ -338,6 +338,9 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     if (!p.ok)
       return;
     const int64_t bound = p.genus + int64_t(diag.handles_cut);
+    // The patches' closure's triangles, sorted, once the tunnels are
+    // looked for.
+    std::vector<std::array<uint32_t, 3>> theirs;
     // The handles first, then the tunnels (where the poles are known),
     // each in rounds of their own.
     for (const bool tunnels : {false, true}) {
@@ -359,10 +362,12 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
         // triangles that the patches' closure lacks are looked at.
         std::vector<uint8_t> only;
         if (tunnels) {
-          std::vector<std::array<uint32_t, 3>> theirs(surf.tris.size() / 3);
-          for (size_t k = 0; k < theirs.size(); ++k)
-            theirs[k] = sorted_corners(surf.tris, k);
-          std::sort(theirs.begin(), theirs.end());
+          if (theirs.empty()) {
+            theirs.resize(surf.tris.size() / 3);
+            for (size_t k = 0; k < theirs.size(); ++k)
+              theirs[k] = sorted_corners(surf.tris, k);
+            std::sort(theirs.begin(), theirs.end());
+          }
           only.assign(m, 0);
           for (size_t k = 0; k < t.size() / 3; ++k)
             if (!std::binary_search(theirs.begin(), theirs.end(),

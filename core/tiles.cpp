@@ -264,10 +264,11 @@ private:
   }
 
   // The subtree of points b to e of idx_, in preorder from node id; `depth`
-  // levels down, with `below`, the subtrees are left there instead. (The
-  // map of counts is only read: every size was counted beforehand.)
+  // levels down, with `below`, the subtrees are left there instead. counts:
+  // node_count()'s, which holds every size of the tree's subtrees.
   void build(size_t b, size_t e, int32_t id, int depth,
-             std::map<size_t, int32_t> &counts, std::vector<Subtree> *below) {
+             const std::map<size_t, int32_t> &counts,
+             std::vector<Subtree> *below) {
     if (below && depth == 0) {
       below->push_back({b, e, id});
       return;
@@ -294,7 +295,7 @@ private:
                                 pts_[3 * size_t(q) + axis];
                        });
       nd.left = id + 1;
-      nd.right = id + 1 + node_count(mid - b, counts);
+      nd.right = id + 1 + (mid - b <= kLeaf ? 1 : counts.at(mid - b));
       build(b, mid, nd.left, depth - 1, counts, below);
       build(mid, e, nd.right, depth - 1, counts, below);
     }
@@ -469,14 +470,6 @@ void split(const double *xyz, std::vector<uint32_t> &idx, size_t b, size_t e,
   leaf();
 }
 
-// Whether p lies in box (closed).
-inline bool in_box(const Box &box, const double *p) {
-  for (int a = 0; a < 3; ++a)
-    if (!(p[a] >= box.lo[a] && p[a] <= box.hi[a]))
-      return false;
-  return true;
-}
-
 // Phase 1: a tile's own points, triangulated (vertices carry input
 // indices), duplicates resolved as the single triangulation resolves them
 // (each vertex keeps the smallest index of its point).
@@ -485,10 +478,8 @@ void triangulate_own(const double *xyz, Tile &t, Progress &progress) {
   std::vector<double> local(3 * n);
   for (size_t i = 0; i < n; ++i)
     std::memcpy(&local[3 * i], xyz + 3 * size_t(t.own[i]), 3 * sizeof(double));
-  std::vector<uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  hilbert_sort(local.data(), order);
-  order = brio_order(order);
+  const std::vector<uint32_t> order =
+      brio_order(hilbert_order(local.data(), n));
   Ch hint;
   for (size_t k = 0; k < n; ++k) {
     progress.tick(k, n);
@@ -1148,17 +1139,6 @@ struct Numbering {
   std::vector<double> pts;
   std::vector<uint16_t> owner;
 };
-
-// The indices of the n points in Hilbert order (resident at once:
-// prefault.hpp).
-std::vector<uint32_t> hilbert_order(const double *xyz, size_t n) {
-  std::vector<uint32_t> order;
-  reserve_resident(order, n);
-  order.resize(n);
-  std::iota(order.begin(), order.end(), 0u);
-  hilbert_sort(xyz, order);
-  return order;
-}
 
 // The vertex numbering of the single triangulation (its Hilbert order of
 // all the points, the first of equal points standing for them), from
