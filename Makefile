@@ -35,7 +35,7 @@ test-sanitize: setup
 test-tsan: setup
 	cmake -S . -B $(BUILD)-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSC_SANITIZE=thread
 	cmake --build $(BUILD)-tsan -j $(JOBS)
-	cd $(BUILD)-tsan && ctest --output-on-failure -j $(JOBS) -LE slow -R '^(daemon|clients)_|^core_tiles_threads$$|^core_api$$|^core_noise_|^core_mesh_sample_dino_watertight$$'
+	cd $(BUILD)-tsan && ctest --output-on-failure -j $(JOBS) -LE slow -R '^(daemon|clients)_|^core_tiles_threads$$|^core_api$$|^core_noise_|^core_mesh_sample_dino_watertight$$|^core_mesh_sample_knot_watertight$$'
 
 # The protocol decoder and the file readers under libFuzzer, ASan and UBSan
 # (clang), for FUZZ_SECONDS each.

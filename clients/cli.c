@@ -249,9 +249,11 @@ void sc_cli_summary(FILE *f, const sc_cli_result_t *r) {
           d->boundary_samples == 1 ? "" : "s",
           (unsigned long long)d->longest_loop);
   if (d->labelled)
-    fprintf(f, "; cells labelled, %s", d->path == SC_PATH_WATERTIGHT_FILL
-                                           ? "the patches' closure kept"
-                                           : "their closure kept");
+    fprintf(f, "; cells labelled, %s",
+            d->path == SC_PATH_WATERTIGHT_FILL ? "the patches' closure kept"
+            : d->path == SC_PATH_COCONE
+                ? "the cocone test's surface at every sample kept"
+                : "their closure kept");
   fprintf(f, ".\n");
   if (d->checked) {
     fprintf(f,

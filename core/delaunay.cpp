@@ -344,9 +344,24 @@ public:
 
   bool close(std::vector<uint32_t> &tris, Progress &progress,
              sc_diag_t &diag) override {
-    bool ok = label_and_close(dt_, tris, progress, diag);
-    dt_.clear();
-    return ok;
+    return label_and_close(dt_, tris, progress, diag);
+  }
+
+  void cocone_everywhere(const sc_params_t &params, Progress &progress,
+                         std::vector<uint32_t> &tris) override {
+    // The labels took the circumcentres' bytes, and a triangulation that
+    // filter() kept has its poles already: both from the start. The counts
+    // go nowhere.
+    for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
+         ++v)
+      v->info() = VertexData(v->info().idx);
+    sc_diag_t scratch{};
+    compute_poles(dt_, infinite_, progress, scratch);
+    sc_params_t cocone = params;
+    cocone.mode = SC_MODE_COCONE;
+    tris.clear();
+    select_candidates(dt_, infinite_, cocone, progress, tris, scratch);
+    canonical_order(tris, false);
   }
 
 private:

@@ -164,9 +164,14 @@ public:
   // or outside and puts in tris (vertex numbers) the boundary of the inside
   // cells, repaired into a 2-manifold as far as relabelling goes (a few
   // pinched vertices may be left). Returns false, leaving tris as it was,
-  // when no cell is inside. Frees the triangulation.
+  // when no cell is inside.
   virtual bool close(std::vector<uint32_t> &tris, Progress &progress,
                      sc_diag_t &diag) = 0;
+  // After close(): puts in tris the candidates of the cocone test at every
+  // sample, with params' cocone_theta, in canonical order: those of cocone
+  // mode on the same points (section 11.5).
+  virtual void cocone_everywhere(const sc_params_t &params, Progress &progress,
+                                 std::vector<uint32_t> &tris) = 0;
   // Moves every vertex by -shift; the caller makes sure each subtraction
   // is exact (recentre()), so the triangulation stays the Delaunay
   // triangulation of its points, cell for cell.
@@ -437,8 +442,10 @@ public:
   // Waits for the labelling, reporting progress (and so taking a cancel)
   // meanwhile; then as Triangulator::close(): the boundary of the inside
   // cells in tris and diag's cells_relabelled, false when no cell is
-  // inside. Rethrows what the thread threw.
-  bool take(std::vector<uint32_t> &tris, Progress &progress, sc_diag_t &diag);
+  // inside; where one is, the triangulation in dt when it has at most
+  // 65 536 points (else dt is null). Rethrows what the thread threw.
+  bool take(std::vector<uint32_t> &tris, Progress &progress, sc_diag_t &diag,
+            std::unique_ptr<Triangulator> &dt);
 
 private:
   struct State;
@@ -476,22 +483,33 @@ private:
   void insert_range(const double *xyz, size_t first, size_t n,
                     Progress &progress);
   // Auto mode: whether watertight mode's closing of surf, extracted with
-  // no hole filled, is one closed piece of lower genus than `genus`; then
-  // surf and diag take that closure.
-  bool auto_cuts_handles(const double *lxyz, size_t m, int64_t genus,
-                         Progress &progress, Surface &surf, sc_diag_t &diag);
+  // no hole filled, is one closed piece of lower genus than `genus`, or
+  // the cocone test's surface at every sample; then surf and diag take
+  // that closure.
+  bool auto_closes_unfilled(const double *lxyz, size_t m, int64_t genus,
+                            Progress &progress, Surface &surf, sc_diag_t &diag);
   // Auto mode: whether surf, extracted, is of a closed surface and is to be
   // closed as in watertight mode.
   bool auto_closes(const double *lxyz, size_t m, const Surface &surf,
                    const sc_diag_t &diag, Progress &progress) const;
   // Watertight mode: closes surf, by labelling the Delaunay cells or by
-  // least-area patches; before the patches, cuts the handles that closed
-  // round holes of the scan when `cut`.
+  // least-area patches (or takes the cocone test's surface at every
+  // sample, section 11.5); before the patches, cuts the handles that
+  // closed round holes of the scan when `cut`.
   void close_surface(const double *lxyz, size_t m, bool cut,
                      Progress &progress, Surface &surf, sc_diag_t &diag);
   // The poles of the vertices, by vertex number, while finish() closes the
-  // surface (close_surface() tells the labelling's tunnels by them).
+  // surface (close_surface() tells the labelling's tunnels by them); and
+  // whether boundary detection left samples out of the candidates' test,
+  // so that the cocone test at every sample gives other candidates.
   const double *closing_poles_ = nullptr;
+  bool closing_everywhere_ = false;
+  // Pruning and extraction (small holes filled) of the candidates cand,
+  // with boundary samples marked in boundary (empty: none), into s and d.
+  void surface_of(const double *lxyz, size_t m,
+                  const std::vector<uint32_t> &cand,
+                  const std::vector<uint8_t> &boundary, Progress &progress,
+                  Surface &s, sc_diag_t &d) const;
   void patch_surface(const double *lxyz, size_t m, bool cut, Progress &progress,
                      Surface &surf, sc_diag_t &diag);
   // Shortcrust mode's check (section 6.5): the cocone test's surface,

@@ -48,7 +48,8 @@ constexpr int kSmallHandleRounds = 12;
 constexpr size_t kMinBubble = 8;
 // Watertight mode keeps a triangulation of at most this many points for
 // the labelling (section 11.5), about 70 MB at most, where at least this
-// share of the samples are boundary samples.
+// share of the samples are boundary samples; the labelling's thread hands
+// one of at most so many points back, for the cocone test's candidates.
 constexpr size_t kKeepForLabels = 65536;
 constexpr double kKeepBoundaryShare = 0.1;
 // Auto mode takes a sample for one of a closed surface where no loop is
@@ -154,7 +155,10 @@ LabelTask::LabelTask(std::unique_ptr<Triangulator> dt, const double *lxyz,
     } catch (...) {
       st.error = std::current_exception();
     }
-    st.dt.reset();
+    // Kept for the cocone test's candidates (close_surface()) where it is
+    // small; a large one is built again there if they are wanted.
+    if (!st.inside || m > kKeepForLabels)
+      st.dt.reset();
     {
       std::lock_guard<std::mutex> lock(st.mu);
       st.done = true;
@@ -169,7 +173,7 @@ LabelTask::~LabelTask() {
 }
 
 bool LabelTask::take(std::vector<uint32_t> &tris, Progress &progress,
-                     sc_diag_t &diag) {
+                     sc_diag_t &diag, std::unique_ptr<Triangulator> &dt) {
   State &st = *state_;
   {
     std::unique_lock<std::mutex> lock(st.mu);
@@ -185,6 +189,7 @@ bool LabelTask::take(std::vector<uint32_t> &tris, Progress &progress,
   if (!st.inside)
     return false;
   tris.swap(st.tris);
+  dt = std::move(st.dt);
   diag.cells_relabelled += st.diag.cells_relabelled;
   return true;
 }
@@ -230,8 +235,12 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   };
 
   // The closure by labels, into a and da; false when no cell is inside.
+  // With it, from the same triangulation, the candidates of the cocone
+  // test at every sample into everywhere, where a third closure may be
+  // taken from them (take_everywhere(), below).
   Surface a;
   sc_diag_t da = diag;
+  std::vector<uint32_t> everywhere;
   auto label = [&] {
     da.labelled = 1;
     // The triangulation that filter() kept (--labels); or, where it went
@@ -239,13 +248,14 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     // numbered as the surface's vertices are.
     // Or the labelling already under way beside the extraction.
     std::vector<uint32_t> labelled;
+    std::unique_ptr<Triangulator> dt;
     if (labelling_) {
-      const bool inside = labelling_->take(labelled, progress, da);
+      const bool inside = labelling_->take(labelled, progress, da, dt);
       labelling_.reset();
       if (!inside)
         return false;
     } else {
-      std::unique_ptr<Triangulator> dt = std::move(kept_);
+      dt = std::move(kept_);
       if (!dt) {
         dt = make_triangulator();
         dt->insert(lxyz, 0, m, progress);
@@ -256,6 +266,20 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     canonical_order(labelled, true);
     describe_manifold(labelled, a, da);
     drop_debris(a, da);
+    // The cocone test's candidates at every sample, where a third closure
+    // may be taken from them (take_everywhere()): boundary detection left
+    // samples out of the candidates' test, the patches closed the surface,
+    // and the labels' closure has more handles than the extracted surface
+    // had.
+    const Closure p(diag);
+    if (closing_everywhere_ && !params_.watertight_labels && p.ok &&
+        da.genus > p.genus + int64_t(diag.handles_cut)) {
+      if (!dt) {
+        dt = make_triangulator();
+        dt->insert(lxyz, 0, m, progress);
+      }
+      dt->cocone_everywhere(params_, progress, everywhere);
+    }
     return true;
   };
   auto take_labels = [&] {
@@ -403,12 +427,51 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     }
   };
 
+  // A third closure, where the patches' closure stands against the labels'
+  // for the handles the labelling made: the cocone test's surface at every
+  // sample (cocone mode's), its small holes filled. Boundary detection can
+  // take samples of a thin tube for boundary samples (its poles are
+  // short), so that extraction opens the tube and the patches cap its two
+  // ends: a true handle lost. Where the cocone test's surface is one
+  // closed piece with no more samples left out than one in a thousand once
+  // attached, and more handles than the extracted surface had but no more
+  // than the labelling found, two tests that read the cells apart support
+  // its handles beyond the patches', and it is kept.
+  auto take_everywhere = [&] {
+    const Closure p(diag);
+    const int64_t bound = p.genus + int64_t(diag.handles_cut);
+    if (everywhere.empty() || !p.ok || labels_genus <= bound)
+      return; // (no candidates: label() saw it would not be taken)
+    Surface s;
+    sc_diag_t d = diag;
+    d.pruned = d.holes_filled = d.hole_triangles = 0;
+    surface_of(lxyz, m, everywhere, {}, progress, s, d);
+    everywhere = std::vector<uint32_t>();
+    if (d.components > 1)
+      drop_small_closed(lxyz, m, s, s.tris.size() / 3 / 100, false, progress,
+                        d);
+    const Closure c(d);
+    if (!c.ok || c.loops > 0 || c.components != 1 || c.genus <= bound ||
+        c.genus > labels_genus)
+      return;
+    Surface sa = s;
+    sc_diag_t dc = d;
+    attach_samples(lxyz, m, sa, progress, dc);
+    if (1000 * dc.samples_unused > m)
+      return;
+    surf = std::move(s);
+    diag = d;
+    diag.path = SC_PATH_COCONE;
+  };
+
   if (labelling && label()) {
     labels_genus = da.genus;
     small_handles();
     if (labels_only ||
         (!Closure(diag).better_than(Closure(da)) && !made_handles()))
       take_labels();
+    else
+      take_everywhere();
   } else if (labels_only) {
     patch(); // no cell came out inside
   }
@@ -450,18 +513,22 @@ bool Recon::auto_closes(const double *lxyz, size_t m, const Surface &surf,
 // Auto mode (section 11.6), where filling the small holes closed the
 // surface in one piece of the given genus: whether watertight mode's
 // closing of surf, the surface before those holes were filled, is one
-// closed piece of lower genus. Then surf and diag take that closure. A
-// thin part meeting the body at a sharp edge (a fin, a blade) is where
-// this happens: the candidates miss a strip along the joint, the walk
-// closes a handle round its end, and filling the small hole left keeps the
-// handle, where watertight mode cuts it first (or labels the cells).
-bool Recon::auto_cuts_handles(const double *lxyz, size_t m, int64_t genus,
-                              Progress &progress, Surface &surf,
-                              sc_diag_t &diag) {
+// closed piece of lower genus, or the cocone test's surface at every
+// sample. Then surf and diag take that closure. A thin part meeting the
+// body at a sharp edge (a fin, a blade) is where the first happens: the
+// candidates miss a strip along the joint, the walk closes a handle round
+// its end, and filling the small hole left keeps the handle, where
+// watertight mode cuts it first (or labels the cells). The second is a
+// thin tube that boundary detection opened and the small holes capped,
+// which the closing keeps as the cocone test does (section 11.5).
+bool Recon::auto_closes_unfilled(const double *lxyz, size_t m, int64_t genus,
+                                 Progress &progress, Surface &surf,
+                                 sc_diag_t &diag) {
   sc_diag_t d = diag;
   Surface s = surf;
   close_surface(lxyz, m, true, progress, s, d);
-  if (!d.closed || d.components != 1 || d.genus >= genus)
+  if (!d.closed || d.components != 1 ||
+      (d.genus >= genus && d.path != SC_PATH_COCONE))
     return false;
   surf = std::move(s);
   diag = d;
@@ -1023,6 +1090,7 @@ sc_mesh_t *Recon::finish() {
     ~ForgetPoles() { poles = nullptr; }
   } forget_poles{closing_poles_};
   closing_poles_ = f.poles.data();
+  closing_everywhere_ = !f.boundary.empty();
   Surface surf;
   // Watertight mode cuts the handles that closed round holes of the scan
   // and then closes every hole, so nothing is filled before that. Where
@@ -1033,7 +1101,7 @@ sc_mesh_t *Recon::finish() {
   const bool scan_holes = watertight && !f.boundary.empty();
   // Auto mode, where it found boundary samples, keeps the surface as
   // extracted too, before its small holes were filled: for
-  // auto_cuts_handles().
+  // auto_closes_unfilled().
   std::vector<uint32_t> unfilled;
   const bool auto_unfilled =
       params_.mode == SC_MODE_AUTO && !f.boundary.empty();
@@ -1073,8 +1141,8 @@ sc_mesh_t *Recon::finish() {
       open_diag.walk_rejected = diag.walk_rejected;
       describe(lxyz.data(), m, unfilled, progress, open, open_diag);
       drop_bubbles(open, open_diag);
-      if (auto_cuts_handles(lxyz.data(), m, diag.genus, progress, open,
-                            open_diag)) {
+      if (auto_closes_unfilled(lxyz.data(), m, diag.genus, progress, open,
+                               open_diag)) {
         surf = std::move(open);
         diag = open_diag;
       }
@@ -1130,6 +1198,19 @@ void Checks::canonical() {
     canonical_order(near[k], false);
 }
 
+void Recon::surface_of(const double *lxyz, size_t m,
+                       const std::vector<uint32_t> &cand,
+                       const std::vector<uint8_t> &boundary, Progress &progress,
+                       Surface &s, sc_diag_t &d) const {
+  std::vector<uint8_t> alive;
+  EdgeTablePtr table;
+  d.candidates = cand.size() / 3;
+  prune(lxyz, m, cand, params_.paper_pruning != 0, boundary, alive, table,
+        progress, d, thread_count());
+  extract(lxyz, m, cand, alive, std::move(table),
+          size_t(params_.max_hole_edges), boundary, progress, s, d);
+}
+
 // Shortcrust mode's check (section 6.5): the surface that the cocone test
 // gives on the same triangulation, through the same pruning and walk, and
 // whether its topology is the same; where it is not, the surfaces of the
@@ -1138,20 +1219,9 @@ void Checks::canonical() {
 void Recon::check_topology(const double *lxyz, size_t m, Filtered &f,
                            const sc_diag_t &before, Progress &progress,
                            Surface &surf, sc_diag_t &diag) const {
-  // One candidate set through pruning and the walk, into s and d.
-  auto surface = [&](const std::vector<uint32_t> &cand, Surface &s,
-                     sc_diag_t &d) {
-    std::vector<uint8_t> alive;
-    EdgeTablePtr table;
-    d.candidates = cand.size() / 3;
-    prune(lxyz, m, cand, params_.paper_pruning != 0, f.boundary, alive, table,
-          progress, d, thread_count());
-    extract(lxyz, m, cand, alive, std::move(table),
-            size_t(params_.max_hole_edges), f.boundary, progress, s, d);
-  };
   sc_diag_t cd = before;
   Surface cs;
-  surface(f.check.cocone, cs, cd);
+  surface_of(lxyz, m, f.check.cocone, f.boundary, progress, cs, cd);
   f.check.cocone = {};
   auto same = [&](const sc_diag_t &d) {
     return d.components == cd.components &&
@@ -1178,7 +1248,7 @@ void Recon::check_topology(const double *lxyz, size_t m, Filtered &f,
           continue;
         sc_diag_t d = before;
         Surface s;
-        surface(f.check.at(k), s, d);
+        surface_of(lxyz, m, f.check.at(k), f.boundary, progress, s, d);
         if (!same(d) || !d.closed)
           continue;
         report(d, r);

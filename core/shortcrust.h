@@ -485,7 +485,8 @@ int sc_params_can_tile(const sc_params_t *p);
   X(labelled, int, , BOOL, "labelled",                                         \
     "watertight: 1 when the Delaunay cells were labelled inside or outside "   \
     "for a closure (the patches left doubt, or watertight_labels); path "      \
-    "watertight-fill then means that the patches' closure was kept")           \
+    "watertight-fill then means that the patches' closure was kept, cocone "   \
+    "that the cocone test's surface at every sample was")                      \
   X(checked, int, , BOOL, "checked",                                           \
     "shortcrust: 1 when the surface was checked against the one the cocone "   \
     "test gives on the same triangulation, else 0 (other modes); in a tile "   \
@@ -560,7 +561,8 @@ const char *sc_diag_element_name(const sc_diag_info_t *row, size_t i);
 
 /* Values of sc_diag_t.path: X(NAME, value, name).
  *  - SHORTCRUST: the paper's criteria.
- *  - COCONE: the cocone test everywhere.
+ *  - COCONE: the cocone test everywhere (in the watertight and auto modes,
+ *    its surface kept over the closures: docs/algorithm.md section 11.5).
  *  - BOUNDARY: the cocone test at interior samples only.
  *  - WATERTIGHT: closed by labelling cells (or nothing was open).
  *  - WATERTIGHT_FILL: closed by patches over the holes. */

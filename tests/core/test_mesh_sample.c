@@ -11,7 +11,12 @@
  * which must be cut (docs/algorithm.md section 11.5), and is cut the same
  * on two threads. The anchor at as many random points as it has vertices:
  * the labelling keeps its four true holes, two of them small, and makes
- * tunnels beside them, which must be cut while the holes stay.
+ * tunnels beside them, which must be cut while the holes stay. The knot
+ * at three times as many random points as it has vertices, and the eight
+ * at as many: boundary detection takes samples of their thin tubes for
+ * boundary samples, extraction opens a tube there and the patches cap it
+ * (genus 0), where the cocone test at every sample keeps it, and must be
+ * kept (docs/algorithm.md section 11.5).
  *
  *   test_core_mesh_sample MESH.ply N SEED MODE [patches]
  *
