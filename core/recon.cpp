@@ -234,6 +234,15 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     }
   };
 
+  // The components of s but the pockets under a hundredth of it, which go
+  // below: they do not count.
+  auto pieces = [](const Surface &s) {
+    uint64_t k = 0;
+    for (const Surface::Part &p : s.parts)
+      k += uint64_t(100 * p.faces) >= s.tris.size() / 3;
+    return k;
+  };
+
   // The closure by labels, into a and da; false when no cell is inside.
   // With it, from the same triangulation, the candidates of the cocone
   // test at every sample into everywhere, where a third closure may be
@@ -268,12 +277,12 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     drop_debris(a, da);
     // The cocone test's candidates at every sample, where a third closure
     // may be taken from them (take_everywhere()): boundary detection left
-    // samples out of the candidates' test, the patches closed the surface,
-    // and the labels' closure has more handles than the extracted surface
-    // had.
+    // samples out of the candidates' test, the patches closed the surface
+    // in one piece, and the labels' closure has more handles than the
+    // extracted surface had.
     const Closure p(diag);
     if (closing_everywhere_ && !params_.watertight_labels && p.ok &&
-        da.genus > p.genus + int64_t(diag.handles_cut)) {
+        pieces(surf) == 1 && da.genus > p.genus + int64_t(diag.handles_cut)) {
       if (!dt) {
         dt = make_triangulator();
         dt->insert(lxyz, 0, m, progress);
@@ -303,14 +312,6 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   const bool patches_first = !labels_only && params_.watertight_patches != 0;
   if (!labels_only)
     patch();
-  // The components of s but the pockets under a hundredth of it, which go
-  // below: they do not count.
-  auto pieces = [](const Surface &s) {
-    uint64_t k = 0;
-    for (const Surface::Part &p : s.parts)
-      k += uint64_t(100 * p.faces) >= s.tris.size() / 3;
-    return k;
-  };
   // The labelling is tried where the patches' closure shows a defect: open,
   // in pieces, samples left out, or a handle that had to be cut. Where the
   // patches give one closed piece (pockets aside) with no handle cut and
@@ -432,15 +433,18 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   // sample (cocone mode's), its small holes filled. Boundary detection can
   // take samples of a thin tube for boundary samples (its poles are
   // short), so that extraction opens the tube and the patches cap its two
-  // ends: a true handle lost. Where the cocone test's surface is one
-  // closed piece with no more samples left out than one in a thousand once
-  // attached, and more handles than the extracted surface had but no more
-  // than the labelling found, two tests that read the cells apart support
-  // its handles beyond the patches', and it is kept.
+  // ends: a true handle lost. Where the patches' closure is one piece and
+  // the cocone test's surface is one closed piece with no more samples
+  // left out than one in a thousand once attached, and more handles than
+  // the extracted surface had but no more than the labelling found, two
+  // tests that read the cells apart support its handles beyond the
+  // patches', and it is kept. (Never where the patches' closure is in
+  // pieces: joining them, it could join separate parts.)
   auto take_everywhere = [&] {
     const Closure p(diag);
     const int64_t bound = p.genus + int64_t(diag.handles_cut);
-    if (everywhere.empty() || !p.ok || labels_genus <= bound)
+    if (everywhere.empty() || !p.ok || pieces(surf) != 1 ||
+        labels_genus <= bound)
       return; // (no candidates: label() saw it would not be taken)
     Surface s;
     sc_diag_t d = diag;
