@@ -1130,21 +1130,39 @@ sc_mesh_t *Recon::finish() {
           closed_before - std::min(closed_before, d.closed_components);
     };
     drop_bubbles(surf, diag);
-    if (watertight) {
-      close_surface(lxyz.data(), m, scan_holes, progress, surf, diag);
-    } else if (auto_closes(lxyz.data(), m, surf, diag, progress)) {
-      // The holes that extraction filled count too.
-      const uint64_t holes = diag.holes_filled, added = diag.hole_triangles;
-      close_surface(lxyz.data(), m, false, progress, surf, diag);
-      diag.holes_filled += holes;
-      diag.hole_triangles += added;
-    } else if (auto_unfilled && diag.closed && diag.components == 1 &&
-               diag.holes_filled > 0) {
-      Surface open;
-      sc_diag_t open_diag = extracting;
+    // Auto mode: the surface as extracted, before its small holes were
+    // filled, its bubbles dropped.
+    auto as_extracted = [&](Surface &open, sc_diag_t &open_diag) {
+      open_diag = extracting;
       open_diag.walk_rejected = diag.walk_rejected;
       describe(lxyz.data(), m, unfilled, progress, open, open_diag);
       drop_bubbles(open, open_diag);
+    };
+    if (watertight) {
+      close_surface(lxyz.data(), m, scan_holes, progress, surf, diag);
+    } else if (auto_closes(lxyz.data(), m, surf, diag, progress)) {
+      // As watertight mode closes it: where boundary samples were found,
+      // from the surface before its small holes were filled, cutting the
+      // handles that closed round a hole first (section 11.6).
+      if (auto_unfilled) {
+        Surface open;
+        sc_diag_t open_diag;
+        as_extracted(open, open_diag);
+        close_surface(lxyz.data(), m, true, progress, open, open_diag);
+        surf = std::move(open);
+        diag = open_diag;
+      } else {
+        // The holes that extraction filled count too.
+        const uint64_t holes = diag.holes_filled, added = diag.hole_triangles;
+        close_surface(lxyz.data(), m, false, progress, surf, diag);
+        diag.holes_filled += holes;
+        diag.hole_triangles += added;
+      }
+    } else if (auto_unfilled && diag.closed && diag.components == 1 &&
+               diag.holes_filled > 0) {
+      Surface open;
+      sc_diag_t open_diag;
+      as_extracted(open, open_diag);
       if (auto_closes_unfilled(lxyz.data(), m, diag.genus, progress, open,
                                open_diag)) {
         surf = std::move(open);

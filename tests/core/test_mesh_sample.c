@@ -16,7 +16,10 @@
  * at as many: boundary detection takes samples of their thin tubes for
  * boundary samples, extraction opens a tube there and the patches cap it
  * (genus 0), where the cocone test at every sample keeps it, and must be
- * kept (docs/algorithm.md section 11.5).
+ * kept (docs/algorithm.md section 11.5). The anchor in auto mode too:
+ * the sample is taken for a closed one, and must be closed as watertight
+ * mode closes it, from the surface before its small holes were filled,
+ * not with them filled (genus 3: section 11.6): to the same triangles.
  *
  *   test_core_mesh_sample MESH.ply N SEED MODE [patches]
  *
@@ -86,6 +89,23 @@ int main(int argc, char **argv) {
     printf("ok: %llu small handles cut, the same on 2 threads\n",
            (unsigned long long)one->diag.small_handles_cut);
     sc_mesh_free(two);
+    /* Auto mode takes each of these samples for a closed one (and does
+     * not smooth it), and closes it to watertight mode's mesh. */
+    if (p.mode == SC_MODE_AUTO) {
+      EXPECT(!one->diag.denoised &&
+             (one->diag.path == SC_PATH_WATERTIGHT ||
+              one->diag.path == SC_PATH_WATERTIGHT_FILL ||
+              (one->diag.path == SC_PATH_COCONE && one->diag.labelled)));
+      sc_params_t w = p;
+      w.mode = SC_MODE_WATERTIGHT;
+      sc_mesh_t *wt = NULL;
+      EXPECT_EQ(sc_reconstruct(xyz, n, &w, &wt, msg, sizeof msg), 0);
+      EXPECT(wt && wt->triangle_count == one->triangle_count &&
+             memcmp(wt->triangles, one->triangles,
+                    3 * one->triangle_count * sizeof *one->triangles) == 0);
+      printf("ok: watertight mode's triangles\n");
+      sc_mesh_free(wt);
+    }
   }
   sc_mesh_free(one);
   scs_meshcheck_free(&truth);
