@@ -428,9 +428,10 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     }
   };
 
-  // A third closure, where the patches' closure stands against the labels'
-  // for the handles the labelling made: the cocone test's surface at every
-  // sample (cocone mode's), its small holes filled. Boundary detection can
+  // A third closure, where the patches' closure stands, in one piece, and
+  // the labels' closure has more handles than the extracted surface had:
+  // the cocone test's surface at every sample (cocone mode's), its small
+  // holes filled. Boundary detection can
   // take samples of a thin tube for boundary samples (its poles are
   // short), so that extraction opens the tube and the patches cap its two
   // ends: a true handle lost. Where the patches' closure is one piece and
