@@ -350,8 +350,8 @@ public:
   void cocone_everywhere(const sc_params_t &params, Progress &progress,
                          std::vector<uint32_t> &tris) override {
     // The labels took the circumcentres' bytes, and a triangulation that
-    // filter() kept has its poles already: both from the start. The counts
-    // go nowhere.
+    // filter() kept has its poles already: poles and circumcentres are
+    // computed again from scratch. The counts go nowhere.
     for (auto v = dt_.finite_vertices_begin(); v != dt_.finite_vertices_end();
          ++v)
       v->info() = VertexData(v->info().idx);

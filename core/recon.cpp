@@ -428,24 +428,22 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   };
 
   // A third closure, where the patches' closure stands, in one piece, and
-  // the labels' closure has more handles than the extracted surface had:
-  // the cocone test's surface at every sample (cocone mode's), its small
-  // holes filled. Boundary detection can
-  // take samples of a thin tube for boundary samples (its poles are
-  // short), so that extraction opens the tube and the patches cap its two
-  // ends: a true handle lost. Where the patches' closure is one piece and
-  // the cocone test's surface is one closed piece with no more samples
-  // left out than one in a thousand once attached, and more handles than
-  // the extracted surface had but no more than the labelling found, two
-  // tests that read the cells apart support its handles beyond the
-  // patches', and it is kept. (Never where the patches' closure is in
-  // pieces: joining them, it could join separate parts.)
+  // the labels' closure has more handles than the extracted surface had
+  // (label() took the candidates for it then): the cocone test's surface
+  // at every sample (cocone mode's), its small holes filled. Boundary
+  // detection can take samples of a thin tube for boundary samples (its
+  // poles are short), so that extraction opens the tube and the patches
+  // cap its two ends: a true handle lost. Where the cocone test's surface
+  // is one closed piece with no more samples left out than one in a
+  // thousand once attached, and more handles than the extracted surface
+  // had but no more than the labelling found, two tests that read the
+  // cells apart support its handles beyond the patches', and it is kept.
+  // (Never where the patches' closure is in pieces: joining them, it could
+  // join separate parts.)
   auto take_everywhere = [&] {
-    const Closure p(diag);
-    const int64_t bound = p.genus + int64_t(diag.handles_cut);
-    if (everywhere.empty() || !p.ok || pieces(surf) != 1 ||
-        labels_genus <= bound)
-      return; // (no candidates: label() saw it would not be taken)
+    if (everywhere.empty())
+      return;
+    const int64_t bound = Closure(diag).genus + int64_t(diag.handles_cut);
     Surface s;
     sc_diag_t d = diag;
     d.pruned = d.holes_filled = d.hole_triangles = 0;
