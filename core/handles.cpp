@@ -324,21 +324,21 @@ namespace {
 // region when in_region(t). Where the region's boundary passes a vertex
 // more than once, each fan of the region there counts as a vertex of its
 // own, and the loops are followed about their vertices through the
-// region's triangles. mark: scratch, a byte per vertex, left all 0.
+// region's triangles. mark: scratch, a byte per vertex, left all 0; par
+// and seen: scratch of any size.
 template <class InRegion>
-int64_t region_twice_genus(const std::vector<uint32_t> &tris,
-                           const std::vector<uint32_t> &twin,
-                           const std::vector<uint32_t> &region,
-                           const std::vector<uint32_t> &at, InRegion in_region,
-                           std::vector<uint8_t> &mark, int64_t &pieces_out,
-                           int64_t &loops_out) {
+int64_t region_twice_genus(
+    const std::vector<uint32_t> &tris, const std::vector<uint32_t> &twin,
+    const std::vector<uint32_t> &region, const std::vector<uint32_t> &at,
+    InRegion in_region, std::vector<uint8_t> &mark, std::vector<uint32_t> &par,
+    std::vector<uint8_t> &seen, int64_t &pieces_out, int64_t &loops_out) {
   const size_t f = region.size();
   auto next_in = [](size_t h) { return h - h % 3 + (h % 3 + 1) % 3; };
   auto inside = [&](size_t h) {
     return twin[h] != UINT32_MAX && in_region(twin[h] / 3);
   };
   // Pieces across edges, by union-find over places in region.
-  std::vector<uint32_t> par(f);
+  par.resize(f);
   std::iota(par.begin(), par.end(), 0u);
   auto root = [&](uint32_t x) {
     while (par[x] != x)
@@ -364,7 +364,7 @@ int64_t region_twice_genus(const std::vector<uint32_t> &tris,
   // Loops: from a boundary half-edge a -> b, the next is the boundary
   // half-edge leaving b met turning about b through the region; seen
   // marks them by place in region and corner.
-  std::vector<uint8_t> seen(3 * f, 0);
+  seen.assign(3 * f, 0);
   for (size_t i = 0; i < f; ++i)
     for (int c = 0; c < 3; ++c) {
       size_t h = 3 * size_t(region[i]) + c;
@@ -461,8 +461,8 @@ public:
     int64_t pieces = 0, loops = 0;
     const int64_t g = region_twice_genus(
         tris_, twin_, region_, place_,
-        [&](uint32_t t) { return tri_stamp_[t] == stamp_; }, mark_, pieces,
-        loops);
+        [&](uint32_t t) { return tri_stamp_[t] == stamp_; }, mark_, par_, seen_,
+        pieces, loops);
     if (g >= 2)
       return kHandle;
     return g == 0 && pieces == 1 && loops == 2 ? kTube : kNothing;
@@ -477,7 +477,10 @@ private:
   const int rings_;
   // Each triangle's place in the region under way.
   std::vector<uint32_t> place_, tri_stamp_, vert_stamp_;
-  std::vector<uint8_t> mark_;
+  // Scratch of region_twice_genus(), kept from probe to probe: the
+  // regions that are not discs are many on a rough closure.
+  std::vector<uint8_t> mark_, seen_;
+  std::vector<uint32_t> par_;
   std::vector<uint32_t> region_, verts_, front_, next_;
   uint32_t stamp_ = 0;
 };
