@@ -11,6 +11,7 @@
 #include "parallel.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <queue>
@@ -485,13 +486,80 @@ private:
   uint32_t stamp_ = 0;
 };
 
+// The triangles of tris by their corners in increasing order, sorted.
+std::vector<std::array<uint32_t, 3>>
+sorted_triangles(const std::vector<uint32_t> &tris) {
+  std::vector<std::array<uint32_t, 3>> keys(tris.size() / 3);
+  for (size_t t = 0; t < keys.size(); ++t) {
+    keys[t] = {tris[3 * t], tris[3 * t + 1], tris[3 * t + 2]};
+    std::sort(keys[t].begin(), keys[t].end());
+  }
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+// What the probes of the last round found that still holds on tris: a
+// probe reads only the stars of the vertices within rings - 1 rings of its
+// vertex, so it finds the same where none of those stars changed. The
+// vertices of the triangles that differ from the last round's surface, and
+// those within `rings` rings of them on tris, are probed again; known
+// marks the others. The cache then holds tris's triangles.
+void keep_probes(size_t n, const std::vector<uint32_t> &tris,
+                 const VertexStar &star, int rings, ProbeCache &cache,
+                 std::vector<uint8_t> &known) {
+  std::vector<std::array<uint32_t, 3>> keys = sorted_triangles(tris);
+  known.assign(n, 0);
+  if (cache.rings == rings && cache.known.size() == n) {
+    std::vector<uint32_t> front;
+    std::vector<uint8_t> stale(n, 0);
+    auto mark = [&](const std::array<uint32_t, 3> &k) {
+      for (uint32_t w : k)
+        if (!stale[w]) {
+          stale[w] = 1;
+          front.push_back(w);
+        }
+    };
+    size_t i = 0, j = 0;
+    while (i < keys.size() || j < cache.keys.size()) {
+      if (j == cache.keys.size() ||
+          (i < keys.size() && keys[i] < cache.keys[j]))
+        mark(keys[i++]);
+      else if (i == keys.size() || cache.keys[j] < keys[i])
+        mark(cache.keys[j++]);
+      else
+        ++i, ++j;
+    }
+    std::vector<uint32_t> next;
+    for (int r = 0; r < rings && !front.empty(); ++r) {
+      next.clear();
+      for (uint32_t u : front)
+        for (uint32_t k = star.first[u]; k < star.first[u + 1]; ++k)
+          for (int c = 0; c < 3; ++c) {
+            const uint32_t w = tris[3 * size_t(star.tris[k]) + c];
+            if (!stale[w]) {
+              stale[w] = 1;
+              next.push_back(w);
+            }
+          }
+      front.swap(next);
+    }
+    for (size_t v = 0; v < n; ++v)
+      known[v] = cache.known[v] && !stale[v];
+  } else {
+    cache.holds.assign(n, kNothing);
+  }
+  cache.rings = rings;
+  cache.keys.swap(keys);
+  cache.known.assign(n, 0); // what this round probes, or keeps
+}
+
 } // namespace
 
 size_t cut_small_handles(const double *xyz, size_t n,
                          std::vector<uint32_t> &tris, int rings,
                          size_t max_sites, const double *poles,
                          const std::vector<uint8_t> *only, unsigned threads,
-                         Progress &progress) {
+                         Progress &progress, ProbeCache *cache) {
   const size_t nt = tris.size() / 3;
   VertexStar star;
   star.build(n, tris, [](size_t) { return true; });
@@ -500,23 +568,39 @@ size_t cut_small_handles(const double *xyz, size_t n,
     EdgeTable table;
     pair_half_edges(n, tris, progress, twin, table);
   }
+  std::vector<uint8_t> known;
+  if (cache)
+    keep_probes(n, tris, star, rings, *cache, known);
   // Every vertex probed first, on the threads, each slice of the vertices
   // with a probe of its own; then, in the order of the vertices, a region
   // that holds a handle is a site unless a site before it covers its
   // vertex. (What a probe finds does not depend on what is covered: the
   // same sites as probing one vertex after another and skipping those
   // covered.)
-  std::vector<uint8_t> holds(n, kNothing);
+  // With a cache, the vertices whose probe still holds are not probed
+  // again (keep_probes()).
+  std::vector<uint8_t> fresh;
+  std::vector<uint8_t> &holds = cache ? cache->holds : fresh;
+  if (!cache)
+    fresh.assign(n, kNothing);
   const size_t slices = threads > 1 && n >= kParallelProbes ? threads : 1;
   run_parallel(slices, threads, progress, [&](size_t i, Progress &mine) {
     RingProbe probe(tris, twin, star, n, rings);
     const size_t from = n * i / slices, to = n * (i + 1) / slices;
     for (size_t v = from; v < to; ++v) {
       mine.tick(v - from, to - from);
-      holds[v] =
-          star.first[v] != star.first[v + 1] && (!poles || (only && (*only)[v]))
-              ? probe.handle_at(uint32_t(v))
-              : uint8_t(kNothing);
+      if (star.first[v] == star.first[v + 1] ||
+          (poles && !(only && (*only)[v]))) {
+        holds[v] = kNothing; // not probed, nor known on the next surface
+        continue;
+      }
+      if (cache && known[v]) {
+        cache->known[v] = 1;
+        continue;
+      }
+      holds[v] = probe.handle_at(uint32_t(v));
+      if (cache)
+        cache->known[v] = 1;
     }
   });
   RingProbe probe(tris, twin, star, n, rings);

@@ -7,6 +7,7 @@
 
 #include "shortcrust.h"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
@@ -328,11 +329,20 @@ size_t cut_handles(const double *xyz, size_t n, std::vector<uint32_t> &tris,
 // cut leaves its two sides joined; the smallest in area first and at most
 // max_sites places; returns how many. The vertices are probed on
 // `threads` threads, for the same result.
+// `cache`, when given, carries the probes from one round to the next with
+// the same rings: only the vertices near triangles that changed since are
+// probed again, for the same result.
+struct ProbeCache {
+  int rings = -1;
+  std::vector<std::array<uint32_t, 3>> keys; // the last surface's triangles
+  std::vector<uint8_t> holds, known; // by vertex: what a probe found, and
+                                     // whether it was probed
+};
 size_t cut_small_handles(const double *xyz, size_t n,
                          std::vector<uint32_t> &tris, int rings,
                          size_t max_sites, const double *poles,
                          const std::vector<uint8_t> *only, unsigned threads,
-                         Progress &progress);
+                         Progress &progress, ProbeCache *cache = nullptr);
 // Closes every hole of at most max_loop edges by a least-area patch (sections 9
 // and 11.3; a loop of more than 16 edges is first cut by short chords into
 // pieces), except the loops that boundary (which may be empty) marks as where

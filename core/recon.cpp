@@ -375,6 +375,9 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
       if (tunnels && (!closing_poles_ || pieces(surf) <= pieces(a)))
         return;
       int rings = kSmallHandleRings;
+      // A round after a kept one, with the same rings, probes again only
+      // near what changed.
+      ProbeCache cache;
       for (int round = 0;
            round < kSmallHandleRounds && rings <= kSmallHandleRingsMax;
            ++round) {
@@ -402,7 +405,7 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
         const size_t sites = cut_small_handles(
             lxyz, m, t, rings, size_t(l.genus - bound),
             tunnels ? closing_poles_ : nullptr, tunnels ? &only : nullptr,
-            thread_count(), progress);
+            thread_count(), progress, &cache);
         Surface b;
         sc_diag_t db = da;
         if (sites) {
