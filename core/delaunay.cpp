@@ -317,11 +317,9 @@ public:
                   sizeof v->info().pole);
     // The triangulation is not needed any more: free it before pruning so
     // that the peak memory is the triangulation's alone (watertight mode
-    // keeps it for the labelling with --labels, and where enough samples
-    // are boundary samples that the labelling nearly always runs).
-    if (!keep && keep_boundary_share > 0 &&
-        double(diag.boundary_samples) >=
-            keep_boundary_share * double(out.to_input.size()))
+    // keeps it for the labelling with --labels, and where boundary
+    // samples were found, so that the labelling may well run).
+    if (!keep && keep_if_boundary && diag.boundary_samples > 0)
       keep = true;
     if (!keep)
       dt_.clear();

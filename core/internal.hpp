@@ -178,10 +178,10 @@ public:
   // triangulation of its points, cell for cell.
   virtual void translate(const double shift[3]) = 0;
   // filter() keeps the triangulation for close() instead of freeing it;
-  // or, where keep_boundary_share is positive, when at least that share of
-  // the vertices are boundary samples, and then sets keep.
+  // or, with keep_if_boundary, where any vertex is a boundary sample, and
+  // then sets keep.
   bool keep = false;
-  double keep_boundary_share = 0;
+  bool keep_if_boundary = false;
 };
 
 // Section 3.4: sets shift to the lower corner of the points' box on each

@@ -1028,10 +1028,8 @@ sc_mesh_t *Recon::finish() {
     // closed or not.
     const bool closing = params_.mode == SC_MODE_WATERTIGHT;
     dt_->keep = closing && params_.watertight_labels;
-    dt_->keep_boundary_share =
-        (closing || params_.mode == SC_MODE_AUTO) && n_ <= kKeepForLabels
-            ? std::numeric_limits<double>::min()
-            : 0;
+    dt_->keep_if_boundary =
+        (closing || params_.mode == SC_MODE_AUTO) && n_ <= kKeepForLabels;
     // On more threads, wherever a boundary sample is found, and always
     // where it is small: the labelling then runs beside the extraction
     // (LabelTask), on it, and stops where the patches settle the closure.
@@ -1039,7 +1037,7 @@ sc_mesh_t *Recon::finish() {
     // doubt, such as the cheese, no longer wait for it to be built again:
     // 4.36 to 2.96-3.40 times CGAL's construction on two threads.)
     if (labels_beside() && !params_.watertight_labels)
-      dt_->keep_boundary_share = std::numeric_limits<double>::min();
+      dt_->keep_if_boundary = true;
     if (labels_beside() && n_ <= kKeepForLabels)
       dt_->keep = true;
     dt_->filter(work, n_, params_, progress, f, diag, seconds_);
