@@ -502,13 +502,11 @@ sorted_triangles(const std::vector<uint32_t> &tris) {
 // probe reads only the stars of the vertices within rings - 1 rings of its
 // vertex, so it finds the same where none of those stars changed. The
 // vertices of the triangles that differ from the last round's surface, and
-// those within `rings` rings of them on tris, are probed again; known
-// marks the others. The cache then holds tris's triangles.
+// those within `rings` rings of them on tris, are probed again: cache.known
+// is left marking the others. The cache then holds tris's triangles.
 void keep_probes(size_t n, const std::vector<uint32_t> &tris,
-                 const VertexStar &star, int rings, ProbeCache &cache,
-                 std::vector<uint8_t> &known) {
+                 const VertexStar &star, int rings, ProbeCache &cache) {
   std::vector<std::array<uint32_t, 3>> keys = sorted_triangles(tris);
-  known.assign(n, 0);
   if (cache.rings == rings && cache.known.size() == n) {
     std::vector<uint32_t> front;
     std::vector<uint8_t> stale(n, 0);
@@ -544,13 +542,13 @@ void keep_probes(size_t n, const std::vector<uint32_t> &tris,
       front.swap(next);
     }
     for (size_t v = 0; v < n; ++v)
-      known[v] = cache.known[v] && !stale[v];
+      cache.known[v] = cache.known[v] && !stale[v];
   } else {
     cache.holds.assign(n, kNothing);
+    cache.known.assign(n, 0);
   }
   cache.rings = rings;
   cache.keys.swap(keys);
-  cache.known.assign(n, 0); // what this round probes, or keeps
 }
 
 } // namespace
@@ -568,9 +566,8 @@ size_t cut_small_handles(const double *xyz, size_t n,
     EdgeTable table;
     pair_half_edges(n, tris, progress, twin, table);
   }
-  std::vector<uint8_t> known;
   if (cache)
-    keep_probes(n, tris, star, rings, *cache, known);
+    keep_probes(n, tris, star, rings, *cache);
   // Every vertex probed first, on the threads, each slice of the vertices
   // with a probe of its own; then, in the order of the vertices, a region
   // that holds a handle is a site unless a site before it covers its
@@ -589,18 +586,13 @@ size_t cut_small_handles(const double *xyz, size_t n,
     const size_t from = n * i / slices, to = n * (i + 1) / slices;
     for (size_t v = from; v < to; ++v) {
       mine.tick(v - from, to - from);
-      if (star.first[v] == star.first[v + 1] ||
-          (poles && !(only && (*only)[v]))) {
-        holds[v] = kNothing; // not probed, nor known on the next surface
-        continue;
-      }
-      if (cache && known[v]) {
-        cache->known[v] = 1;
-        continue;
-      }
-      holds[v] = probe.handle_at(uint32_t(v));
+      const bool probed = star.first[v] != star.first[v + 1] &&
+                          (!poles || (only && (*only)[v]));
+      if (cache && probed && cache->known[v])
+        continue; // as the last round found
+      holds[v] = probed ? probe.handle_at(uint32_t(v)) : uint8_t(kNothing);
       if (cache)
-        cache->known[v] = 1;
+        cache->known[v] = probed;
     }
   });
   RingProbe probe(tris, twin, star, n, rings);
