@@ -43,6 +43,9 @@ struct Marks {
 };
 constexpr Marks kFirstRound{0x7fc5a5a6u, 0x7fc5a5a8u};
 constexpr Marks kRingRound{0x7fc5a5a7u, 0x7fc5a5a9u};
+// Neither: a cell whose check found a point to insert, which may leave it
+// standing (certify()).
+constexpr uint32_t kUnchecked = 0;
 // A cell's own search for a point in its ball reads at most this many
 // leaves of the tree before it leaves the cell to the sweep (certify()).
 constexpr size_t kLeafBudget = 48;
@@ -790,6 +793,44 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own,
     add.push_back(best);
 }
 
+// Whether point p, which lies in cell c of tile t's triangulation, lies
+// in the closed ball of a cell with a wanted corner (for an infinite cell:
+// beyond its hull facet, or in its plane and in its closed circle). The
+// cells whose closed balls hold p make one region, joined across facets,
+// about the cell that holds it (walking from any of them toward p stays in
+// the region), so a search from c across the facets of that region finds
+// them all. Closed balls, not the insertion's perturbed test: a point on
+// the sphere of a cell that the perturbation leaves outside it may fall
+// inside the perturbed sphere of a cell that a later point makes on the
+// same sphere (eight corners of a box of a CAD part's vertex set on one
+// sphere), while a point in none of the closed wanted balls of its moment
+// is in none later (see certify()). region and stack are scratch.
+bool in_wanted_ball(const DtSeq &dt, const Point &p, Ch c, const Wanted &want,
+                    std::vector<Ch> &region, std::vector<Ch> &stack) {
+  bool hit = false;
+  region.assign(1, c);
+  stack.assign(1, c);
+  c->tds_data().mark_in_conflict();
+  while (!stack.empty() && !hit) {
+    const Ch x = stack.back();
+    stack.pop_back();
+    for (int j = 0; j < 4 && !hit; ++j)
+      hit = !dt.is_infinite(x->vertex(j)) && want(x->vertex(j)->info().idx);
+    for (int f = 0; f < 4 && !hit; ++f) {
+      const Ch y = x->neighbor(f);
+      if (!y->tds_data().is_clear() ||
+          dt.side_of_sphere(y, p) == CGAL::ON_UNBOUNDED_SIDE)
+        continue;
+      y->tds_data().mark_in_conflict();
+      region.push_back(y);
+      stack.push_back(y);
+    }
+  }
+  for (Ch x : region)
+    x->tds_data().clear();
+  return hit;
+}
+
 // Phase 2: grows tile t until every cell with a vertex of its own is
 // certified: a finite cell's circumscribed ball, closed, holds no point of
 // all that the tile lacks; a hull facet has none beyond it. A ball inside
@@ -850,11 +891,19 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
       const uint32_t m = mark_of(c);
       if (m == marks.checked || m == marks.open)
         return;
+      const size_t found = add.size();
       set_mark(c, marks.checked);
       if (t.dt.is_infinite(c))
         check_hull(s, t, own, want, c, add);
       else if (check_cell(s, t, own, want, c, add, kLeafBudget))
         set_mark(c, marks.open);
+      // A point in the ball or beyond the facet goes in, and nearly always
+      // destroys the cell; but one on its sphere (or in its plane, on its
+      // circle) may leave it standing, where the perturbation puts it
+      // outside, with other points on the sphere still to take: such a
+      // cell is checked again.
+      if (add.size() > found)
+        set_mark(c, kUnchecked);
       too_many();
     };
     // The points in add go in, and the cells they make are checked.
@@ -904,7 +953,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
     // bands of distance, and in each band in vertex order, which is a
     // Hilbert order: each point is located near the one before.
     std::vector<std::pair<uint32_t, uint32_t>> cand; // band, vertex
-    std::vector<std::pair<Ch, int>> hole;
+    std::vector<Ch> region, stack;
     auto sweep = [&](double extent) {
       const Box out = grown(t.reach, extent);
       const double band = extent / kSweepBands;
@@ -935,18 +984,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
         const Point p(q[0], q[1], q[2]);
         const Ch c = t.dt.locate(p, hint);
         t.work += kSweepCost;
-        hole.clear();
-        t.dt.find_conflicts(p, c, std::back_inserter(hole),
-                            CGAL::Emptyset_iterator());
-        // Every vertex of a cell in conflict is on the hole's boundary.
-        bool hit = false;
-        for (size_t h = 0; h < hole.size() && !hit; ++h)
-          for (int j = 0; j < 4 && !hit; ++j) {
-            const Vh w = hole[h].first->vertex(j);
-            hit = j != hole[h].second && !t.dt.is_infinite(w) &&
-                  want(w->info().idx);
-          }
-        if (!hit) {
+        if (!in_wanted_ball(t.dt, p, c, want, region, stack)) {
           hint = c;
           continue;
         }
@@ -1002,8 +1040,11 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
           least = c, first = i;
       }
       for (size_t i = 0; i < first; ++i) {
+        const size_t found = add.size();
         set_mark(open[i].second, marks.checked);
         (void)check_cell(s, t, own, want, open[i].second, add, SIZE_MAX);
+        if (add.size() > found)
+          set_mark(open[i].second, kUnchecked);
         too_many();
       }
       if (!add.empty()) {
