@@ -419,6 +419,14 @@ struct Tile {
   bool numbered = false; // vertices carry vertex numbers, not input indices
   size_t foreign = 0;    // points of other tiles inserted
   double work = 0;    // of certify(): leaves of the tree read, and sweeping
+  // Planes of hull facets that no point outside the tile lies beyond
+  // (check_hull()).
+  struct ClearPlane {
+    Point a, b, c; // three points of the plane
+    V3 normal;     // unit, outward
+    double offset; // normal . a
+  };
+  std::vector<ClearPlane> clear_planes;
   Tile() { std::memset(&diag, 0, sizeof diag); }
 };
 
@@ -751,10 +759,28 @@ bool check_cell(const Shared &s, Tile &t, const Ownership &own,
   return leaves == 0;
 }
 
+// A hull facet whose full search (check_hull()) met at least this many
+// points exactly in its plane, and found none that makes it wrong, leaves
+// its plane to the tile's clear planes.
+constexpr size_t kCoplanarToRemember = 16;
+// At most this many clear planes a tile.
+constexpr size_t kClearPlanes = 64;
+
 // Checks infinite cell c of tile t: its hull facet is one of all the points
 // only if no point lies beyond its plane (or on it, inside its circle,
 // where the perturbation decides). The point beyond nearest to the facet
 // goes into add.
+//
+// Where many points lie exactly in the plane (a face of a box sampled on a
+// grid, a planar face of a CAD part's vertex set), every hull facet of the
+// tile in that plane would read them all, each with exact predicates (the
+// filters cannot decide a point in the plane). So once a facet's search
+// has met many such points and found none beyond, its plane is
+// remembered: no point outside the tile lies beyond it, then or later (the
+// tile only takes points in). A later facet in the same plane (its corners
+// in it, by the exact orientation) needs only the points in its circle,
+// which lie in a small ball; the nearest of those accepted is the point
+// the whole search would have taken.
 void check_hull(const Shared &s, Tile &t, const Ownership &own,
                 const Wanted &want, Ch c, std::vector<uint32_t> &add) {
   const int inf = c->index(t.dt.infinite_vertex());
@@ -774,9 +800,56 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own,
   if (dot(nrm, v3(po) - v3(pa)) > 0)
     nrm = -1.0 * nrm;
   const double a[3] = {pa.x(), pa.y(), pa.z()}, nv[3] = {nrm.x, nrm.y, nrm.z};
-  const double tol = 1e-9 * std::sqrt(norm2(nrm)) * s.tree->extent();
+  const double extent = s.tree->extent();
+  const double tol = 1e-9 * std::sqrt(norm2(nrm)) * extent;
   const V3 mid = (1.0 / 3) * (v3(pa) + v3(pb) + v3(pc));
   const double centre[3] = {mid.x, mid.y, mid.z};
+  auto in_circle = [&](const Point &pq) {
+    return CGAL::coplanar_side_of_bounded_circle(pa, pb, pc, pq) !=
+           CGAL::ON_UNBOUNDED_SIDE;
+  };
+
+  // In a clear plane: the points in the facet's circle, within a ball
+  // about the centre that holds the circle (where the circle is well
+  // conditioned).
+  const V3 unit = (1 / std::sqrt(norm2(nrm))) * nrm;
+  const double offset = dot(unit, v3(pa));
+  V3 cc;
+  if (tri_circumcentre(v3(pa), v3(pb), v3(pc), cc)) {
+    const double r = std::sqrt(
+        std::max({norm2(cc - v3(pa)), norm2(cc - v3(pb)), norm2(cc - v3(pc))}));
+    const double far = std::sqrt(norm2(cc - mid)) + r;
+    for (const Tile::ClearPlane &cp : t.clear_planes) {
+      if (!(dot(cp.normal, unit) > 1 - 1e-9 &&
+            std::fabs(cp.offset - offset) <= 1e-9 * extent &&
+            CGAL::orientation(cp.a, cp.b, cp.c, pa) == CGAL::COPLANAR &&
+            CGAL::orientation(cp.a, cp.b, cp.c, pb) == CGAL::COPLANAR &&
+            CGAL::orientation(cp.a, cp.b, cp.c, pc) == CGAL::COPLANAR))
+        continue;
+      // (A nearly flat facet, whose circle is a million times its edge or
+      // more, is searched in full: its centre is not to be trusted.)
+      if (!(r < 1e6 * std::sqrt(norm2(v3(pb) - v3(pa)))) || !std::isfinite(far))
+        break;
+      const double reach = far + 1e-6 * far + 1e-9 * extent;
+      size_t leaves = SIZE_MAX;
+      const uint32_t best = s.tree->nearest_in_ball(
+          centre, reach * reach, t.reach.lo, t.reach.hi,
+          [&](uint32_t v) {
+            if (own(v) || t.member[v])
+              return false;
+            const double *q = s.pts + 3 * size_t(v);
+            const Point pq(q[0], q[1], q[2]);
+            return CGAL::orientation(pa, pb, pc, pq) == CGAL::COPLANAR &&
+                   in_circle(pq);
+          },
+          leaves);
+      if (best != UINT32_MAX)
+        add.push_back(best);
+      return;
+    }
+  }
+
+  size_t coplanar = 0;
   const uint32_t best = s.tree->nearest_beyond(
       centre, a, nv, tol, t.reach.lo, t.reach.hi, [&](uint32_t v) {
         if (own(v) || t.member[v])
@@ -784,13 +857,18 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own,
         const double *q = s.pts + 3 * size_t(v);
         const Point pq(q[0], q[1], q[2]);
         const CGAL::Orientation o = CGAL::orientation(pa, pb, pc, pq);
-        return !(o == inner ||
-                 (o == CGAL::COPLANAR &&
-                  CGAL::coplanar_side_of_bounded_circle(pa, pb, pc, pq) ==
-                      CGAL::ON_UNBOUNDED_SIDE));
+        if (o == inner)
+          return false;
+        if (o != CGAL::COPLANAR)
+          return true;
+        ++coplanar;
+        return in_circle(pq);
       });
   if (best != UINT32_MAX)
     add.push_back(best);
+  else if (coplanar >= kCoplanarToRemember &&
+           t.clear_planes.size() < kClearPlanes)
+    t.clear_planes.push_back({pa, pb, pc, unit, offset});
 }
 
 // Whether point p, which lies in cell c of tile t's triangulation, lies
