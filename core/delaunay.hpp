@@ -172,12 +172,21 @@ template <class Ch> V3 hull_normal(Ch c, int inf, V3 *pts) {
     if (c->vertex((inf + 1 + k) % 4)->info().idx <
         c->vertex((inf + 1 + first) % 4)->info().idx)
       first = k;
-  for (int k = 0; k < 3; ++k)
-    pts[k] = v3(c->vertex((inf + 1 + (first + k) % 3) % 4)->point());
+  const Point *corner[3];
+  for (int k = 0; k < 3; ++k) {
+    corner[k] = &c->vertex((inf + 1 + (first + k) % 3) % 4)->point();
+    pts[k] = v3(*corner[k]);
+  }
   V3 n = cross(pts[1] - pts[0], pts[2] - pts[0]);
+  // Away from the finite cell's fourth corner, by the exact orientation:
+  // where that corner lies nearly in the facet's plane (a flat face of the
+  // hull, sampled), the rounded dot product can come out 0 or of either
+  // sign, and would turn the normal inward in one triangulation and not
+  // in another.
   Ch inner = c->neighbor(inf);
-  V3 o = v3(inner->vertex(inner->index(c))->point());
-  if (dot(n, o - pts[0]) > 0)
+  if (CGAL::orientation(*corner[0], *corner[1], *corner[2],
+                        inner->vertex(inner->index(c))->point()) ==
+      CGAL::POSITIVE)
     n = -1.0 * n;
   double l = std::sqrt(norm2(n));
   return l > 0 ? (1 / l) * n : V3{0, 0, 0};

@@ -796,8 +796,11 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own,
   Ch in = c->neighbor(inf);
   const Point &po = in->vertex(in->index(c))->point();
   const CGAL::Orientation inner = CGAL::orientation(pa, pb, pc, po);
+  // Outward: away from the inner side, as the exact orientation has it
+  // (the sign of the same determinant, which rounding may flip where the
+  // cell is nearly flat).
   V3 nrm = cross(v3(pb) - v3(pa), v3(pc) - v3(pa));
-  if (dot(nrm, v3(po) - v3(pa)) > 0)
+  if (inner == CGAL::POSITIVE)
     nrm = -1.0 * nrm;
   const double a[3] = {pa.x(), pa.y(), pa.z()}, nv[3] = {nrm.x, nrm.y, nrm.z};
   const double extent = s.tree->extent();
