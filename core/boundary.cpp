@@ -104,7 +104,14 @@ std::vector<uint16_t> measure_cells(DT &dt, double sin2_c, double cos_a,
         longest2 = std::max(longest2, len[i][j]);
       }
     }
-    const bool trusted = norm2(cc - P[0]) <= kMaxCentreRatio2 * longest2;
+    // (From the corner with the smallest number: how a cell orders its
+    // corners depends on the order of insertion, and where the test is
+    // close, so would its outcome, in tiles as against one triangulation.)
+    int first = 0;
+    for (int j = 1; j < 4; ++j)
+      if (c->vertex(j)->info().idx < c->vertex(first)->info().idx)
+        first = j;
+    const bool trusted = norm2(cc - P[first]) <= kMaxCentreRatio2 * longest2;
     for (int j = 0; j < 4; ++j) {
       VertexData &d = c->vertex(j)->info();
       for (int i = 0; i < 4; ++i)

@@ -136,11 +136,17 @@ private:
         d.nbr[f] = c->neighbor(f)->info().w.local;
       if (dt_.is_infinite(c))
         continue; // after the finite ones, below
-      const Point o =
-          CGAL::circumcenter(c->vertex(0)->point(), c->vertex(1)->point(),
-                             c->vertex(2)->point(), c->vertex(3)->point());
+      // The corners in the order of their numbers: how a cell orders them
+      // depends on the order of insertion, and so would the rounding
+      // (the labels of a triangulation built again, in tiles or in a
+      // daemon's chunks, would differ).
+      Vh v[4] = {c->vertex(0), c->vertex(1), c->vertex(2), c->vertex(3)};
+      std::sort(v, v + 4,
+                [](Vh a, Vh b) { return a->info().idx < b->info().idx; });
+      const Point o = CGAL::circumcenter(v[0]->point(), v[1]->point(),
+                                         v[2]->point(), v[3]->point());
       d.o[0] = float(o.x()), d.o[1] = float(o.y()), d.o[2] = float(o.z());
-      d.r2 = float(CGAL::squared_distance(o, c->vertex(0)->point()));
+      d.r2 = float(CGAL::squared_distance(o, v[0]->point()));
     }
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
       if (dt_.is_infinite(c)) {
@@ -407,6 +413,17 @@ private:
     }
   }
 
+  // Of the corners of facet fi of cell c, (fi + 1 + k) % 4 for k = 0, 1,
+  // 2, the k of the one with the smallest number.
+  static int first_corner(Ch c, int fi) {
+    int first = 0;
+    for (int k = 1; k < 3; ++k)
+      if (c->vertex((fi + 1 + k) % 4)->info().idx <
+          c->vertex((fi + 1 + first) % 4)->info().idx)
+        first = k;
+    return first;
+  }
+
   // The unit normal of facet f of cell c, pointing away from c's vertex f
   // (for an infinite cell, the hull facet's outward normal); false for a
   // facet too small to tell.
@@ -417,9 +434,12 @@ private:
       in = c->neighbor(f);
       fi = in->index(c);
     }
-    const Point &a = in->vertex((fi + 1) % 4)->point();
-    const Point &b = in->vertex((fi + 2) % 4)->point();
-    const Point &d = in->vertex((fi + 3) % 4)->point();
+    // From the corner with the smallest number, in the cell's cyclic order
+    // (see weigh()).
+    const int first = first_corner(in, fi);
+    const Point &a = in->vertex((fi + 1 + first) % 4)->point();
+    const Point &b = in->vertex((fi + 1 + (first + 1) % 3) % 4)->point();
+    const Point &d = in->vertex((fi + 1 + (first + 2) % 3) % 4)->point();
     K::Vector_3 n = CGAL::cross_product(b - a, d - a);
     const double len = std::sqrt(n.squared_length());
     if (!(len > 0))
@@ -442,7 +462,7 @@ private:
     double nrm[3];
     if (!outward_normal(fin, fi, nrm))
       return 0;
-    const Point &a = fin->vertex((fi + 1) % 4)->point();
+    const Point &a = fin->vertex((fi + 1 + first_corner(fin, fi)) % 4)->point();
     const double h = nrm[0] * (b.o[0] - a.x()) + nrm[1] * (b.o[1] - a.y()) +
                      nrm[2] * (b.o[2] - a.z());
     return float(std::max(-1.0, std::min(1.0, -h / std::sqrt(double(b.r2)))));

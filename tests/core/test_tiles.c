@@ -5,12 +5,13 @@
  * synthetic sample, a real scan, a grid (cospherical everywhere, flat hull
  * faces) and a very uneven density; a cancel during the tiles stops them
  * all; the modes that run one triangulation say so (tiles 0); points
- * smoothed on two threads are smoothed as on one. Each tile
+ * smoothed on two threads are smoothed as on one. A FILE that is a mesh is
+ * sampled at 6000 random points over its surface. Each tile
  * run as a job of its own (tile_count, tile_index) and merged
  * (sc_reconstruct_merge()) gives the same, and results that cannot be one
  * job's tiles are refused.
  *
- *   test_core_tiles [SCAN.ply ...]
+ *   test_core_tiles [SCAN.ply|MESH.ply ...]
  *   test_core_tiles --quick [CLOSED.ply ...]
  *                  (a small torus on two threads, one triangulation
  *                   scanned on two, watertight mode's labelling beside
@@ -389,15 +390,36 @@ int main(int argc, char **argv) {
         }
   check("grid box", xyz, kept, 1);
 
-  /* Real scans, as given. */
+  /* Real scans, as given; and a mesh's surface at 6000 random points (a
+   * flat face of the hull, sampled, where the hull facets' normals turned
+   * inward at random; thin parts, which the labelling closes on a
+   * triangulation built again for it). */
   for (int a = 1; a < argc; ++a) {
-    scf_points_t pts;
+    scf_points_t pts = {0};
+    uint32_t *tri = NULL;
+    size_t ntri = 0;
     char msg[256];
-    if (scf_points_read(argv[a], &pts, msg, sizeof msg) != 0) {
+    if (scf_mesh_read(argv[a], &pts, &tri, &ntri, msg, sizeof msg) != 0) {
       EXPECT_FAIL("%s: %s", argv[a], msg);
       continue;
     }
-    check(argv[a], pts.xyz, pts.count, 1);
+    if (ntri > 0) {
+      const size_t k = 6000;
+      double *some = malloc(3 * k * sizeof *some);
+      EXPECT_NOT_NULL(some);
+      if (some &&
+          scs_sample_mesh(pts.xyz, pts.count, tri, ntri, k, 1, some) == 0) {
+        char what[300];
+        snprintf(what, sizeof what, "%s, %zu random points", argv[a], k);
+        check(what, some, k, 1);
+      } else {
+        EXPECT_FAIL("%s: cannot sample", argv[a]);
+      }
+      free(some);
+    } else {
+      check(argv[a], pts.xyz, pts.count, 1);
+    }
+    free(tri);
     scf_points_free(&pts);
   }
 
@@ -490,9 +512,16 @@ cancel : {
     sc_mesh_free(t);
     for (int a = 1; a < argc; ++a) {
       scf_points_t pts;
+      uint32_t *tri = NULL;
+      size_t ntri = 0;
       char msg[256];
-      if (scf_points_read(argv[a], &pts, msg, sizeof msg) != 0)
+      if (scf_mesh_read(argv[a], &pts, &tri, &ntri, msg, sizeof msg) != 0)
         continue;
+      free(tri);
+      if (ntri > 0) { /* the scans only */
+        scf_points_free(&pts);
+        continue;
+      }
       one = run(argv[a], pts.xyz, pts.count, SC_MODE_COCONE, 1, 1);
       t = run(argv[a], pts.xyz, pts.count, SC_MODE_COCONE, 0, 2);
       if (one && t)
