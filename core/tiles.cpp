@@ -1094,8 +1094,15 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
     check_hull_cells();
     drain();
     for (;;) {
-      if (uncertified(true) < 0)
-        break;
+      if (uncertified(true) < 0) {
+        // No finite cell open; a hull facet that a point on its circle
+        // left standing is checked again.
+        check_hull_cells();
+        if (add.empty())
+          break;
+        drain();
+        continue;
+      }
       // The open balls that reach farthest search alone, the others are
       // swept: as many of each as cost the least.
       std::sort(
