@@ -12,6 +12,7 @@
  * job's tiles are refused.
  *
  *   test_core_tiles [SCAN.ply|MESH.ply ...]
+ *   test_core_tiles --files SCAN.ply|MESH.ply ...   (only those)
  *   test_core_tiles --quick [CLOSED.ply ...]
  *                  (a small torus on two threads, one triangulation
  *                   scanned on two, watertight mode's labelling beside
@@ -274,8 +275,47 @@ static void labelling_beside(const char *path) {
   scf_points_free(&pts);
 }
 
+/* A real scan, as given; or a mesh's surface at 6000 random points (a flat
+ * face of the hull, sampled, where the hull facets' normals turned inward
+ * at random; thin parts, which the labelling closes on a triangulation
+ * built again for it): check() in every mode. */
+static void check_file(const char *path) {
+  scf_points_t pts = {0};
+  uint32_t *tri = NULL;
+  size_t ntri = 0;
+  char msg[256];
+  if (scf_mesh_read(path, &pts, &tri, &ntri, msg, sizeof msg) != 0) {
+    EXPECT_FAIL("%s: %s", path, msg);
+    return;
+  }
+  if (ntri > 0) {
+    const size_t k = 6000;
+    double *some = malloc(3 * k * sizeof *some);
+    EXPECT_NOT_NULL(some);
+    if (some &&
+        scs_sample_mesh(pts.xyz, pts.count, tri, ntri, k, 1, some) == 0) {
+      char what[300];
+      snprintf(what, sizeof what, "%s, %zu random points", path, k);
+      check(what, some, k, 1);
+    } else {
+      EXPECT_FAIL("%s: cannot sample", path);
+    }
+    free(some);
+  } else {
+    check(path, pts.xyz, pts.count, 1);
+  }
+  free(tri);
+  scf_points_free(&pts);
+}
+
 int main(int argc, char **argv) {
   const int quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
+  /* The files alone, as a test of its own that runs beside the rest. */
+  if (argc > 1 && strcmp(argv[1], "--files") == 0) {
+    for (int a = 2; a < argc; ++a)
+      check_file(argv[a]);
+    return sct_finish("core_tiles");
+  }
   /* A torus, well spaced, with a few exact duplicates. */
   const size_t n = quick ? 5000 : 12000, dups = 50;
   double *xyz = malloc(3 * (n + dups) * sizeof *xyz);
@@ -390,38 +430,9 @@ int main(int argc, char **argv) {
         }
   check("grid box", xyz, kept, 1);
 
-  /* Real scans, as given; and a mesh's surface at 6000 random points (a
-   * flat face of the hull, sampled, where the hull facets' normals turned
-   * inward at random; thin parts, which the labelling closes on a
-   * triangulation built again for it). */
-  for (int a = 1; a < argc; ++a) {
-    scf_points_t pts = {0};
-    uint32_t *tri = NULL;
-    size_t ntri = 0;
-    char msg[256];
-    if (scf_mesh_read(argv[a], &pts, &tri, &ntri, msg, sizeof msg) != 0) {
-      EXPECT_FAIL("%s: %s", argv[a], msg);
-      continue;
-    }
-    if (ntri > 0) {
-      const size_t k = 6000;
-      double *some = malloc(3 * k * sizeof *some);
-      EXPECT_NOT_NULL(some);
-      if (some &&
-          scs_sample_mesh(pts.xyz, pts.count, tri, ntri, k, 1, some) == 0) {
-        char what[300];
-        snprintf(what, sizeof what, "%s, %zu random points", argv[a], k);
-        check(what, some, k, 1);
-      } else {
-        EXPECT_FAIL("%s: cannot sample", argv[a]);
-      }
-      free(some);
-    } else {
-      check(argv[a], pts.xyz, pts.count, 1);
-    }
-    free(tri);
-    scf_points_free(&pts);
-  }
+  /* Real scans, and meshes (check_file()). */
+  for (int a = 1; a < argc; ++a)
+    check_file(argv[a]);
 
   /* Cancel while the tiles triangulate, on two threads. */
 cancel : {
