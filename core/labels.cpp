@@ -322,14 +322,15 @@ private:
     for (const uint32_t h : hull) {
       const Ch c = cells_[h];
       const int k = c->index(dt_.infinite_vertex());
-      double nrm[3];
-      if (!outward_normal(c, k, nrm))
+      V3 corner[3];
+      const V3 nrm = hull_normal(c, k, corner);
+      if (!(norm2(nrm) > 0))
         continue;
       for (int j = 1; j < 4; ++j) {
         Poles &p = poles[c->vertex((k + j) % 4)->info().idx];
         p.hull = true;
-        for (int a = 0; a < 3; ++a)
-          p.dir[a] += float(nrm[a]);
+        p.dir[0] += float(nrm.x), p.dir[1] += float(nrm.y),
+            p.dir[2] += float(nrm.z);
       }
     }
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
@@ -413,58 +414,20 @@ private:
     }
   }
 
-  // Of the corners of facet fi of cell c, (fi + 1 + k) % 4 for k = 0, 1,
-  // 2, the k of the one with the smallest number.
-  static int first_corner(Ch c, int fi) {
-    int first = 0;
-    for (int k = 1; k < 3; ++k)
-      if (c->vertex((fi + 1 + k) % 4)->info().idx <
-          c->vertex((fi + 1 + first) % 4)->info().idx)
-        first = k;
-    return first;
-  }
-
-  // The unit normal of facet f of cell c, pointing away from c's vertex f
-  // (for an infinite cell, the hull facet's outward normal); false for a
-  // facet too small to tell.
-  bool outward_normal(Ch c, int f, double nrm[3]) const {
-    Ch in = c;
-    int fi = f;
-    if (dt_.is_infinite(c->vertex(f))) { // look from the finite side
-      in = c->neighbor(f);
-      fi = in->index(c);
-    }
-    // From the corner with the smallest number, in the cell's cyclic order
-    // (see weigh()).
-    const int first = first_corner(in, fi);
-    const Point &a = in->vertex((fi + 1 + first) % 4)->point();
-    const Point &b = in->vertex((fi + 1 + (first + 1) % 3) % 4)->point();
-    const Point &d = in->vertex((fi + 1 + (first + 2) % 3) % 4)->point();
-    K::Vector_3 n = CGAL::cross_product(b - a, d - a);
-    const double len = std::sqrt(n.squared_length());
-    if (!(len > 0))
-      return false;
-    if (n * (in->vertex(fi)->point() - a) > 0)
-      n = -n;
-    for (int k = 0; k < 3; ++k)
-      nrm[k] = n[k] / len;
-    return true;
-  }
-
   // The cosine of the angle at which the sphere of the finite neighbour of
   // infinite cell c (across its hull facet, opposite vertex k, the
   // infinite one) crosses the outer half-space of that facet: the finite
   // cell's centre is h above the facet (outward), and the cosine -h / r.
+  // (The normal, hull_normal(), as the poles stage has it.)
   float hull_crossing(Ch c, int k) const {
-    Ch fin = c->neighbor(k);
-    const int fi = fin->index(c);
-    const Node &b = node_[fin->info().w.local];
-    double nrm[3];
-    if (!outward_normal(fin, fi, nrm))
+    const Node &b = node_[c->neighbor(k)->info().w.local];
+    V3 corner[3];
+    const V3 nrm = hull_normal(c, k, corner);
+    if (!(norm2(nrm) > 0))
       return 0;
-    const Point &a = fin->vertex((fi + 1 + first_corner(fin, fi)) % 4)->point();
-    const double h = nrm[0] * (b.o[0] - a.x()) + nrm[1] * (b.o[1] - a.y()) +
-                     nrm[2] * (b.o[2] - a.z());
+    const double h = nrm.x * (b.o[0] - corner[0].x) +
+                     nrm.y * (b.o[1] - corner[0].y) +
+                     nrm.z * (b.o[2] - corner[0].z);
     return float(std::max(-1.0, std::min(1.0, -h / std::sqrt(double(b.r2)))));
   }
 

@@ -796,15 +796,13 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own,
   Ch in = c->neighbor(inf);
   const Point &po = in->vertex(in->index(c))->point();
   const CGAL::Orientation inner = CGAL::orientation(pa, pb, pc, po);
-  // Outward: away from the inner side, as the exact orientation has it
-  // (the sign of the same determinant, which rounding may flip where the
-  // cell is nearly flat).
-  V3 nrm = cross(v3(pb) - v3(pa), v3(pc) - v3(pa));
-  if (inner == CGAL::POSITIVE)
-    nrm = -1.0 * nrm;
-  const double a[3] = {pa.x(), pa.y(), pa.z()}, nv[3] = {nrm.x, nrm.y, nrm.z};
+  // The outward unit normal, as the poles stage has it.
+  V3 corner[3];
+  const V3 unit = hull_normal(c, inf, corner);
+  const double a[3] = {pa.x(), pa.y(), pa.z()},
+               nv[3] = {unit.x, unit.y, unit.z};
   const double extent = s.tree->extent();
-  const double tol = 1e-9 * std::sqrt(norm2(nrm)) * extent;
+  const double tol = 1e-9 * extent;
   const V3 mid = (1.0 / 3) * (v3(pa) + v3(pb) + v3(pc));
   const double centre[3] = {mid.x, mid.y, mid.z};
   auto in_circle = [&](const Point &pq) {
@@ -815,7 +813,6 @@ void check_hull(const Shared &s, Tile &t, const Ownership &own,
   // In a clear plane: the points in the facet's circle, within a ball
   // about the centre that holds the circle (where the circle is well
   // conditioned).
-  const V3 unit = (1 / std::sqrt(norm2(nrm))) * nrm;
   const double offset = dot(unit, v3(pa));
   V3 cc;
   if (tri_circumcentre(v3(pa), v3(pb), v3(pc), cc)) {
