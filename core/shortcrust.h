@@ -264,8 +264,8 @@ typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
     SC_RANGE_LO_OPEN | SC_RANGE_ZERO_DEFAULT, "positive", LOCAL, 0,            \
     "memory-limit", "BYTES",                                                   \
     "keep the peak memory near BYTES (a number, or with K, M, G or T: powers " \
-    "of 1024) by triangulating tiles a few at a time, each twice; the same "   \
-    "mesh (cocone and shortcrust modes)")                                      \
+    "of 1024, 1.5G too) by triangulating tiles a few at a time, each twice; "  \
+    "the same mesh (cocone and shortcrust modes)")                             \
   X(tile_count, int, INT, 0, 2, 4096, SC_RANGE_CLOSED | SC_RANGE_ZERO_DEFAULT, \
     "in [2, 4096]", OPTION, 0, NULL, NULL,                                     \
     "a tile job: reconstruct only tile tile_index of the job split into this " \

@@ -1185,13 +1185,15 @@ constexpr double kTileBytes = 1500;
 constexpr double kTileGrowth = 2.0;
 
 namespace {
-// A size for a message: "5.6 MB", or bytes below a tenth of a megabyte.
-std::string size_text(double bytes) {
+// A size for a message: "5.6 MB", or bytes below a tenth of a megabyte;
+// with up, rounded up (a least size that the user may give back).
+std::string size_text(double bytes, bool up = false) {
   char buf[32];
   if (bytes < 104857.6)
-    std::snprintf(buf, sizeof buf, "%.0f bytes", bytes);
+    std::snprintf(buf, sizeof buf, "%.0f bytes", up ? std::ceil(bytes) : bytes);
   else
-    std::snprintf(buf, sizeof buf, "%.1f MB", bytes / 1048576);
+    std::snprintf(buf, sizeof buf, "%.1f MB",
+                  up ? std::ceil(bytes / 1048576 * 10) / 10 : bytes / 1048576);
   return buf;
 }
 } // namespace
@@ -1216,7 +1218,8 @@ size_t memory_tiles(size_t n, unsigned threads, double limit) {
                   "%zu points are too few to split into tiles (%zu a tile), "
                   "and one triangulation of them needs a memory limit of at "
                   "least %s, got %s",
-                  n, dt::kMinTilePoints, size_text(kUntiledBytes * pts).c_str(),
+                  n, dt::kMinTilePoints,
+                  size_text(kUntiledBytes * pts, true).c_str(),
                   size_text(limit).c_str());
     throw Error(SC_ENO_MEMORY, buf);
   }
@@ -1228,7 +1231,7 @@ size_t memory_tiles(size_t n, unsigned threads, double limit) {
                 "stages after the triangulation take about %.0f bytes a "
                 "point whatever the tiles, and %u tile%s of %.0f points at a "
                 "time %s)",
-                n, size_text(need).c_str(), size_text(limit).c_str(),
+                n, size_text(need, true).c_str(), size_text(limit).c_str(),
                 kAfterBytes, threads, threads == 1 ? "" : "s", least_tile,
                 size_text(per_tile_point * least_tile).c_str());
   throw Error(SC_ENO_MEMORY, buf);

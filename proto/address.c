@@ -118,6 +118,18 @@ int scp_bytes_parse(const char *text, uint64_t *out) {
   unsigned long long v = strtoull(text, &end, 10);
   if (errno)
     return SCP_ERANGE;
+  /* A fraction, with a unit only ("1.5G"): its digits, read by hand so
+   * that the locale's decimal point does not matter. */
+  const char *frac = NULL;
+  size_t frac_digits = 0;
+  if (*end == '.') {
+    frac = end + 1;
+    while (frac[frac_digits] >= '0' && frac[frac_digits] <= '9')
+      ++frac_digits;
+    if (frac_digits == 0)
+      return SCP_ERANGE;
+    end = (char *)frac + frac_digits;
+  }
   unsigned shift = 0;
   switch (*end) {
   case '\0':
@@ -141,8 +153,30 @@ int scp_bytes_parse(const char *text, uint64_t *out) {
   if (*end && end[1] != '\0' && strcmp(end + 1, "iB") != 0 &&
       strcmp(end + 1, "B") != 0)
     return SCP_ERANGE;
-  if (v == 0 || (shift && v > (UINT64_MAX >> shift)))
+  if (frac && shift == 0)
+    return SCP_ERANGE; /* no fraction of a byte */
+  if (shift && v > (UINT64_MAX >> shift))
     return SCP_ERANGE;
-  *out = (uint64_t)v << shift;
+  uint64_t bytes = (uint64_t)v << shift;
+  if (frac) {
+    /* The fraction of the unit, to the byte, rounded up: 2^shift times
+     * the digits over 10^digits (the first 6 digits: a millionth of a
+     * unit). */
+    uint64_t num = 0, den = 1;
+    for (size_t i = 0; i < frac_digits && i < 6; ++i) {
+      num = 10 * num + (uint64_t)(frac[i] - '0');
+      den *= 10;
+    }
+    const uint64_t unit = (uint64_t)1 << shift;
+    /* num < den <= 10^6 and unit <= 2^40: each product fits in 64
+     * bits. */
+    const uint64_t part = unit / den * num + (unit % den * num + den - 1) / den;
+    if (bytes > UINT64_MAX - part)
+      return SCP_ERANGE;
+    bytes += part;
+  }
+  if (bytes == 0)
+    return SCP_ERANGE;
+  *out = bytes;
   return 0;
 }

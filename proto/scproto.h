@@ -252,9 +252,11 @@ char *scp_address_format(const scp_address_t *a, char *buf, size_t len);
 
 /* A size in bytes as the daemon's --memory-budget and the command's
  * --memory-limit take it: digits, then optionally K, M, G or T (powers of
- * 1024; k too), optionally followed by B or iB ("512M", "2GiB"). 0 with
- * *out set (never 0 bytes); SCP_ERANGE for anything else, an overflow
- * included; SCP_EINVAL for NULL. */
+ * 1024; k too), optionally followed by B or iB ("512M", "2GiB"); with a
+ * unit, the digits may have a fraction ("24.5M", "1.5G": rounded up to
+ * the byte, to a millionth of the unit). 0 with *out set (never 0 bytes);
+ * SCP_ERANGE for anything else, an overflow included; SCP_EINVAL for
+ * NULL. */
 int scp_bytes_parse(const char *text, uint64_t *out);
 
 /* Element formats of chunk frames. */

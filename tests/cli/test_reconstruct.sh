@@ -140,7 +140,16 @@ expect 0 "it fits the memory limit" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --
 rm -f "$tmp/x.ply"
 expect 1 "need a memory limit of at least .* MB, got 1.0 MB" "$sc" reconstruct "$data/bunny_points.ply" -o "$tmp/x.ply" --memory-limit 1M
 [ -e "$tmp/x.ply" ] && fail "a refused job wrote its output"
-for bad in abc 0 -5 12X 1MBs 99999999999999999999; do
+# The least limit a refusal names, given back as it is written, fits: the
+# same mesh.
+least=$("$sc" reconstruct "$data/bunny_points.ply" -o "$tmp/x.ply" \
+  --memory-limit 1M 2>&1 | sed -n 's/.*at least \([0-9.]*\) MB.*/\1/p')
+[ -n "$least" ] || fail "no least memory limit named"
+expect 0 "within the memory limit" "$sc" reconstruct "$data/bunny_points.ply" \
+  -o "$tmp/b1.ply" --memory-limit "${least}M"
+cmp -s "$tmp/b0.ply" "$tmp/b1.ply" || fail "--memory-limit ${least}M: another mesh"
+expect 0 "it fits the memory limit" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --memory-limit 1.5GiB
+for bad in abc 0 -5 12X 1MBs 99999999999999999999 1.5 .5M 1.M 0.0M; do
   expect 2 "memory-limit: expected a size in bytes" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --memory-limit "$bad"
 done
 expect 2 "memory_limit works in the cocone and shortcrust modes only" "$sc" reconstruct "$knot" -o "$tmp/x.ply" --mode watertight --memory-limit 1G
