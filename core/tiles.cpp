@@ -61,6 +61,12 @@ constexpr double kMostWork = 200;
 struct NotTileable {
   size_t foreign; // the points the tile had taken in
 };
+// Thrown by certify() when a tile within a memory limit grows past the
+// memory the limit leaves it (Tile::most_bytes).
+struct OverLimit {
+  double bytes;        // what the tile's triangulation had come to
+  size_t own, foreign; // its own points and those it had taken in
+};
 
 // What the open cells cost (certify()), in leaves of the tree read: a
 // cell's own search without a budget, about (with the cells that the
@@ -419,6 +425,9 @@ struct Tile {
   bool numbered = false; // vertices carry vertex numbers, not input indices
   size_t foreign = 0;    // points of other tiles inserted
   double work = 0;    // of certify(): leaves of the tree read, and sweeping
+  // Within a memory limit: the most its triangulation may take (bytes()),
+  // or HUGE_VAL.
+  double most_bytes = HUGE_VAL;
   // Planes of hull facets that no point outside the tile lies beyond
   // (check_hull()).
   struct ClearPlane {
@@ -428,6 +437,15 @@ struct Tile {
   };
   std::vector<ClearPlane> clear_planes;
   Tile() { std::memset(&diag, 0, sizeof diag); }
+  // The memory of its triangulation, in bytes: the cells and vertices it
+  // has room for (freed cells are kept for the next insertion), and the
+  // marks of the points it holds. A triangulation of a closed surface's
+  // sample has about 16 cells a vertex, a scan's about 6.
+  double bytes() const {
+    return double(dt.tds().cells().capacity()) * sizeof(DtSeq::Cell) +
+           double(dt.tds().vertices().capacity()) * sizeof(DtSeq::Vertex) +
+           double(member.capacity()) / 8;
+  }
 };
 
 // Splits idx[b, e) (input indices) into k tiles by counts: at the median
@@ -960,6 +978,8 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
   auto too_many = [&]() {
     if (double(t.foreign) > most_foreign || t.work > most_work)
       throw NotTileable{t.foreign};
+    if (t.bytes() > t.most_bytes)
+      throw OverLimit{t.bytes(), owned, t.foreign};
   };
   std::vector<uint32_t> add;
   std::vector<Ch> around;
@@ -1237,6 +1257,37 @@ size_t memory_tiles(size_t n, unsigned threads, double limit) {
   throw Error(SC_ENO_MEMORY, buf);
 }
 
+// Within a memory limit, a tile stops the job once its triangulation, with
+// as many as large beside it and what stays through the tiles, would take
+// more than this many times the limit (dt::tiled_filter()).
+constexpr double kLimitSlack = 1.3;
+
+// Throws the error of a job whose tile outgrew the memory limit (a tile of
+// `own` points had taken in `foreign` others, its triangulation `bytes`).
+[[noreturn]] void over_limit(size_t n, unsigned threads, double limit,
+                             double bytes, size_t own, size_t foreign) {
+  const unsigned at_once = std::max(1u, threads);
+  char each[64] = "";
+  if (at_once > 1)
+    std::snprintf(each, sizeof each, " to each of the %u tiles at a time",
+                  at_once);
+  char buf[512];
+  std::snprintf(
+      buf, sizeof buf,
+      "%zu points: the memory limit of %s cannot be kept: the tiles' "
+      "Delaunay balls reach far across each other (as on exact samples of "
+      "a closed surface), and a tile of %zu points took in %zu of the "
+      "others, %s of triangulation where the limit leaves %s%s; one "
+      "triangulation of all the points needs about %s (a limit of at "
+      "least that does not tile)",
+      n, size_text(limit).c_str(), own, foreign, size_text(bytes).c_str(),
+      size_text(std::max(0.0, kLimitSlack * limit - kFixedBytes * double(n)) /
+                double(at_once))
+          .c_str(),
+      each, size_text(kUntiledBytes * double(n), true).c_str());
+  throw Error(SC_ENO_MEMORY, buf);
+}
+
 namespace dt {
 
 namespace {
@@ -1354,11 +1405,14 @@ std::vector<uint32_t> in_reach(const Shared &s, const Tile &t) {
 // its reach and then until its cells are certified (certify(); with ring,
 // one ring more). False, having certified nothing, when the tile spans no
 // volume; with give_up, NotTileable when the tile takes in too many
-// (certify()).
+// (certify()); OverLimit when it outgrows t.most_bytes.
 bool grow_tile(const Shared &s, Tile &t, size_t m, bool ring, bool give_up,
                Progress &progress) {
   t.member.assign(m, false);
   (void)insert_foreign(s, t, in_reach(s, t), progress);
+  if (t.bytes() > t.most_bytes)
+    throw OverLimit{t.bytes(), t.dt.number_of_vertices() - t.foreign,
+                    t.foreign};
   if (t.dt.dimension() < 3)
     return false;
   certify(s, t, progress, ring, give_up);
@@ -1515,19 +1569,37 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
     // set and drops the triangulation; the second triangulates the same
     // vertices again (the same cells: they are certified) and tests its
     // facets once every pole is known.
-    run_parallel(k, threads, progress, [&](size_t i, Progress &p) {
-      Tile &t = ts[i];
-      if (!grow(t, p))
-        return;
-      sc_diag_t scratch;
-      std::memset(&scratch, 0, sizeof scratch);
-      poles(t, p, scratch);
-      t.vertices.reserve(t.dt.number_of_vertices());
-      for (auto v = t.dt.finite_vertices_begin();
-           v != t.dt.finite_vertices_end(); ++v)
-        t.vertices.push_back(v->info().idx);
-      drop(t);
-    });
+    //
+    // The number of tiles came from a model of their growth (a tile takes
+    // in about as many points of the others as it owns: memory_tiles()),
+    // which samples of closed surfaces can exceed threefold (their tiles'
+    // Delaunay balls reach across the tube or the solid). So a tile whose
+    // triangulation outgrows what the limit leaves it, with as many as
+    // large beside it, stops the job: it fails with a message rather than
+    // run far past the limit (docs/algorithm.md section 17.5). What a
+    // tile may take depends on its own points alone, not on which tiles
+    // run together.
+    const double room =
+        kLimitSlack * params.memory_limit - kFixedBytes * double(n);
+    for (Tile &t : ts)
+      t.most_bytes = std::max(room, 0.0) / double(std::max(1u, threads));
+    try {
+      run_parallel(k, threads, progress, [&](size_t i, Progress &p) {
+        Tile &t = ts[i];
+        if (!grow(t, p))
+          return;
+        sc_diag_t scratch;
+        std::memset(&scratch, 0, sizeof scratch);
+        poles(t, p, scratch);
+        t.vertices.reserve(t.dt.number_of_vertices());
+        for (auto v = t.dt.finite_vertices_begin();
+             v != t.dt.finite_vertices_end(); ++v)
+          t.vertices.push_back(v->info().idx);
+        drop(t);
+      });
+    } catch (const OverLimit &e) {
+      over_limit(n, threads, params.memory_limit, e.bytes, e.own, e.foreign);
+    }
     if (flat.load())
       return false;
     seconds[SC_STAGE_DELAUNAY] += sw.lap();
