@@ -467,12 +467,12 @@ cancel : {
       sc_params_t p;
       sc_params_init(&p);
       p.threads = threads[k];
-      p.memory_limit = 16 << 20;
+      p.memory_limit = 24 << 20;
       sc_mesh_t *t = NULL;
       char msg[256] = "";
       EXPECT_EQ(sc_reconstruct(xyz, n, &p, &t, msg, sizeof msg), SC_OK);
       if (t)
-        same("torus within 16 MB", one, t, (int)t->diag.tiles, threads[k]);
+        same("torus within 24 MB", one, t, (int)t->diag.tiles, threads[k]);
       sc_mesh_free(t);
     }
     sc_mesh_free(one);
