@@ -62,7 +62,7 @@ struct NotTileable {
   size_t foreign; // the points the tile had taken in
 };
 // Thrown by certify() when a tile within a memory limit grows past the
-// memory the limit leaves it (Tile::most_bytes).
+// memory the limit leaves it (Shared::most_bytes).
 struct OverLimit {
   double bytes;        // what the tile's triangulation had come to
   size_t own, foreign; // its own points and those it had taken in
@@ -424,10 +424,7 @@ struct Tile {
   sc_diag_t diag;
   bool numbered = false; // vertices carry vertex numbers, not input indices
   size_t foreign = 0;    // points of other tiles inserted
-  double work = 0;    // of certify(): leaves of the tree read, and sweeping
-  // Within a memory limit: the most its triangulation may take (bytes()),
-  // or HUGE_VAL.
-  double most_bytes = HUGE_VAL;
+  double work = 0;       // of certify(): leaves of the tree read, and sweeping
   // Planes of hull facets that no point outside the tile lies beyond
   // (check_hull()).
   struct ClearPlane {
@@ -661,7 +658,18 @@ struct Shared {
   const double *pts;     // distinct points by vertex number
   const uint16_t *owner; // by vertex number
   const PointTree *tree;
+  // Within a memory limit: the most a tile's triangulation may take
+  // (Tile::bytes()); HUGE_VAL otherwise.
+  double most_bytes = HUGE_VAL;
 };
+
+// Throws OverLimit when tile t, with `owned` points of its own, has
+// outgrown what the memory limit leaves it (s.most_bytes).
+void keep_within(const Shared &s, const Tile &t, size_t owned) {
+  const double bytes = t.bytes();
+  if (bytes > s.most_bytes)
+    throw OverLimit{bytes, owned, t.foreign};
+}
 
 // Inserts the vertices `add` (vertex numbers, sorted) into tile t; returns
 // their handles.
@@ -978,8 +986,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
   auto too_many = [&]() {
     if (double(t.foreign) > most_foreign || t.work > most_work)
       throw NotTileable{t.foreign};
-    if (t.bytes() > t.most_bytes)
-      throw OverLimit{t.bytes(), owned, t.foreign};
+    keep_within(s, t, owned);
   };
   std::vector<uint32_t> add;
   std::vector<Ch> around;
@@ -1271,6 +1278,14 @@ size_t memory_tiles(size_t n, unsigned threads, double limit) {
 // more than this many times the limit (dt::tiled_filter()).
 constexpr double kLimitSlack = 1.3;
 
+// What a memory limit leaves each of the `threads` tiles at a time for its
+// triangulation, in bytes (dt::tiled_filter()).
+double tile_room(size_t n, unsigned threads, double limit) {
+  return std::max(0.0, kLimitSlack * limit - kProcessBytes -
+                           kFixedBytes * double(n)) /
+         double(std::max(1u, threads));
+}
+
 // Throws the error of a job whose tile outgrew the memory limit (a tile of
 // `own` points had taken in `foreign` others, its triangulation `bytes`).
 [[noreturn]] void over_limit(size_t n, unsigned threads, double limit,
@@ -1290,11 +1305,8 @@ constexpr double kLimitSlack = 1.3;
       "triangulation of all the points needs about %s (a limit of at "
       "least that does not tile)",
       n, size_text(limit).c_str(), own, foreign, size_text(bytes).c_str(),
-      size_text(std::max(0.0, kLimitSlack * limit - kProcessBytes -
-                                  kFixedBytes * double(n)) /
-                double(at_once))
-          .c_str(),
-      each, size_text(kProcessBytes + kUntiledBytes * double(n), true).c_str());
+      size_text(tile_room(n, threads, limit)).c_str(), each,
+      size_text(kProcessBytes + kUntiledBytes * double(n), true).c_str());
   throw Error(SC_ENO_MEMORY, buf);
 }
 
@@ -1415,14 +1427,12 @@ std::vector<uint32_t> in_reach(const Shared &s, const Tile &t) {
 // its reach and then until its cells are certified (certify(); with ring,
 // one ring more). False, having certified nothing, when the tile spans no
 // volume; with give_up, NotTileable when the tile takes in too many
-// (certify()); OverLimit when it outgrows t.most_bytes.
+// (certify()); OverLimit when it outgrows s.most_bytes.
 bool grow_tile(const Shared &s, Tile &t, size_t m, bool ring, bool give_up,
                Progress &progress) {
   t.member.assign(m, false);
   (void)insert_foreign(s, t, in_reach(s, t), progress);
-  if (t.bytes() > t.most_bytes)
-    throw OverLimit{t.bytes(), t.dt.number_of_vertices() - t.foreign,
-                    t.foreign};
+  keep_within(s, t, t.dt.number_of_vertices() - t.foreign);
   if (t.dt.dimension() < 3)
     return false;
   certify(s, t, progress, ring, give_up);
@@ -1522,7 +1532,18 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
   const size_t m = out.to_input.size();
 
   const PointTree tree(pts.data(), m, threads, progress);
-  const Shared shared{pts.data(), owner.data(), &tree};
+  Shared shared{pts.data(), owner.data(), &tree};
+  // Within a memory limit, the number of tiles came from a model of their
+  // growth (a tile takes in about as many points of the others as it
+  // owns: memory_tiles()), which samples of closed surfaces can exceed
+  // threefold (their tiles' Delaunay balls reach across the tube or the
+  // solid). So a tile whose triangulation outgrows what the limit leaves
+  // it, with as many as large beside it, stops the job: it fails with a
+  // message rather than run far past the limit (docs/algorithm.md section
+  // 17.5). What a tile may take depends on its own points alone, not on
+  // which tiles run together.
+  if (bounded)
+    shared.most_bytes = tile_room(n, threads, params.memory_limit);
 
   // Phase 2: each tile numbered as the single triangulation, grown by the
   // hull and its margin, and certified.
@@ -1579,20 +1600,6 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
     // set and drops the triangulation; the second triangulates the same
     // vertices again (the same cells: they are certified) and tests its
     // facets once every pole is known.
-    //
-    // The number of tiles came from a model of their growth (a tile takes
-    // in about as many points of the others as it owns: memory_tiles()),
-    // which samples of closed surfaces can exceed threefold (their tiles'
-    // Delaunay balls reach across the tube or the solid). So a tile whose
-    // triangulation outgrows what the limit leaves it, with as many as
-    // large beside it, stops the job: it fails with a message rather than
-    // run far past the limit (docs/algorithm.md section 17.5). What a
-    // tile may take depends on its own points alone, not on which tiles
-    // run together.
-    const double room = kLimitSlack * params.memory_limit - kProcessBytes -
-                        kFixedBytes * double(n);
-    for (Tile &t : ts)
-      t.most_bytes = std::max(room, 0.0) / double(std::max(1u, threads));
     try {
       run_parallel(k, threads, progress, [&](size_t i, Progress &p) {
         Tile &t = ts[i];
