@@ -162,6 +162,21 @@ struct Criteria {
   }
 };
 
+// The four vertices of finite cell c into v, in the order of their
+// numbers: how a cell orders its vertices depends on the order of
+// insertion, and what is computed from them in that order would round
+// differently in another triangulation of the same points (tiles, a
+// daemon's chunks, one built again).
+template <class Ch, class Vh> void corners_by_number(Ch c, Vh (&v)[4]) {
+  for (int j = 0; j < 4; ++j)
+    v[j] = c->vertex(j);
+  auto order = [&](int i, int j) {
+    if (v[j]->info().idx < v[i]->info().idx)
+      std::swap(v[i], v[j]);
+  };
+  order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
+}
+
 // Outward unit normal of the hull facet of infinite cell c (its infinite
 // vertex is vertex inf).
 template <class Ch> V3 hull_normal(Ch c, int inf, V3 *pts) {

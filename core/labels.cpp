@@ -136,13 +136,11 @@ private:
         d.nbr[f] = c->neighbor(f)->info().w.local;
       if (dt_.is_infinite(c))
         continue; // after the finite ones, below
-      // The corners in the order of their numbers: how a cell orders them
-      // depends on the order of insertion, and so would the rounding
-      // (the labels of a triangulation built again, in tiles or in a
-      // daemon's chunks, would differ).
-      Vh v[4] = {c->vertex(0), c->vertex(1), c->vertex(2), c->vertex(3)};
-      std::sort(v, v + 4,
-                [](Vh a, Vh b) { return a->info().idx < b->info().idx; });
+      // The corners in the order of their numbers, so that the labels of
+      // a triangulation built again, in tiles or in a daemon's chunks, are
+      // the same.
+      Vh v[4];
+      corners_by_number(c, v);
       const Point o = CGAL::circumcenter(v[0]->point(), v[1]->point(),
                                          v[2]->point(), v[3]->point());
       d.o[0] = float(o.x()), d.o[1] = float(o.y()), d.o[2] = float(o.z());

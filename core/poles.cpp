@@ -49,15 +49,10 @@ V3 cell_circumcentre(V3 a, V3 b, V3 c, V3 d, bool &guarded) {
 template <class DT>
 V3 centre(typename DT::Cell_handle c, sc_diag_t *diag) {
   typedef typename DT::Vertex_handle Vh;
-  // Taken in the order of the vertex numbers: how a cell happens to order
-  // its vertices depends on the order of insertion, and on nearly flat
-  // cells the rounding of the centre is enough to change the surface.
-  Vh v[4] = {c->vertex(0), c->vertex(1), c->vertex(2), c->vertex(3)};
-  auto order = [&](int i, int j) {
-    if (v[j]->info().idx < v[i]->info().idx)
-      std::swap(v[i], v[j]);
-  };
-  order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
+  // Taken in the order of the vertex numbers: on nearly flat cells the
+  // rounding of the centre is enough to change the surface.
+  Vh v[4];
+  corners_by_number(c, v);
   bool guarded;
   V3 cc = cell_circumcentre(v3(v[0]->point()), v3(v[1]->point()),
                             v3(v[2]->point()), v3(v[3]->point()), guarded);
