@@ -15,21 +15,6 @@ namespace {
 // when given them.
 constexpr size_t kParallelCells = 1u << 14;
 
-// Where a point of the dual Voronoi edge lies relative to the cocone of a
-// sample: -1 or +1 in one of the two cones around the pole, 0 inside the
-// cocone.
-// (Compared squared: no square root or division in this test, which runs
-// six times a facet.)
-inline int cone_side(V3 dir, V3 pole_unit, double sin2_cocone) {
-  const double len2 = norm2(dir);
-  if (!(len2 > 0))
-    return 0;
-  const double d = dot(dir, pole_unit);
-  if (d * d <= sin2_cocone * len2)
-    return 0;
-  return d > 0 ? 1 : -1;
-}
-
 // What the paper's first criterion compares with cos theta: the unit
 // normal n of triangle P and c1 = |n . pole| at the vertex with the largest
 // angle, the one opposite the longest edge. False for a degenerate

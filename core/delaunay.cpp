@@ -340,9 +340,9 @@ public:
     seconds[SC_STAGE_CANDIDATES] += sw.lap();
   }
 
-  bool close(std::vector<uint32_t> &tris, Progress &progress,
-             sc_diag_t &diag) override {
-    return label_and_close(dt_, tris, progress, diag);
+  bool close(std::vector<uint32_t> &tris, Progress &progress, sc_diag_t &diag,
+             double cocone_theta) override {
+    return label_and_close(dt_, tris, progress, diag, cocone_theta);
   }
 
   void cocone_everywhere(const sc_params_t &params, Progress &progress,

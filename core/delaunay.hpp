@@ -129,6 +129,21 @@ inline bool finite(V3 a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
 
+// Where a point of the dual Voronoi edge, at dir from a sample, lies
+// relative to the sample's cocone (docs/algorithm.md section 6.3): -1 or +1
+// in one of the two cones around the pole, 0 inside the cocone.
+// (Compared squared: no square root or division in this test, which runs
+// six times a facet.)
+inline int cone_side(V3 dir, V3 pole_unit, double sin2_cocone) {
+  const double len2 = norm2(dir);
+  if (!(len2 > 0))
+    return 0;
+  const double d = dot(dir, pole_unit);
+  if (d * d <= sin2_cocone * len2)
+    return 0;
+  return d > 0 ? 1 : -1;
+}
+
 // Circumcentre of triangle abc; returns false when it is degenerate.
 inline bool tri_circumcentre(V3 a, V3 b, V3 c, V3 &out) {
   V3 u = b - a, v = c - a, w = cross(u, v);
@@ -365,7 +380,7 @@ std::unique_ptr<Triangulator> adopt_triangulation(DtSeq &dt, const double *xyz,
 // Triangulator::close().
 template <class DT>
 bool label_and_close(DT &dt, std::vector<uint32_t> &tris, Progress &progress,
-                     sc_diag_t &diag);
+                     sc_diag_t &diag, double cocone_theta);
 
 } // namespace dt
 } // namespace sc

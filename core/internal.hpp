@@ -165,9 +165,12 @@ public:
   // or outside and puts in tris (vertex numbers) the boundary of the inside
   // cells, repaired into a 2-manifold as far as relabelling goes (a few
   // pinched vertices may be left). Returns false, leaving tris as it was,
-  // when no cell is inside.
+  // when no cell is inside. cocone_theta is the cocone test's, by which the
+  // labels do not cross the facets it finds on the surface where the
+  // balls reach through it (a coarse sample); 0 where the points are
+  // noisy, for the test then finds facets between the layers of the noise.
   virtual bool close(std::vector<uint32_t> &tris, Progress &progress,
-                     sc_diag_t &diag) = 0;
+                     sc_diag_t &diag, double cocone_theta) = 0;
   // After close(): puts in tris the candidates of the cocone test at every
   // sample, with params' cocone_theta, in canonical order: those of cocone
   // mode on the same points (section 11.5).
@@ -373,6 +376,10 @@ struct NoiseEstimate {
   // half the noise, and a coarse sample (the vertices of a decimated mesh,
   // a few hundred points on a handle) bends them much more.
   bool resolved() const { return curvature <= 0.15 + 0.5 * noise; }
+  // Whether the points are noisy: denoising (and auto mode) smooths them
+  // (section 16.2; SC_NOISE_FLOOR was measured with shortcrust-noise-table
+  // and on the shared closed models, README "Noise").
+  bool noisy() const { return noise >= SC_NOISE_FLOOR && resolved(); }
 };
 // The estimate from the neighbourhoods of a fixed subset of the points (the
 // same whatever chunks the points arrived in).
@@ -445,7 +452,8 @@ size_t memory_tiles(size_t n, unsigned threads, double limit);
 // lxyz must outlive the task. Destroying it stops and joins the thread.
 class LabelTask {
 public:
-  LabelTask(std::unique_ptr<Triangulator> dt, const double *lxyz, size_t m);
+  LabelTask(std::unique_ptr<Triangulator> dt, const double *lxyz, size_t m,
+            double cocone_theta);
   ~LabelTask();
   LabelTask(const LabelTask &) = delete;
   LabelTask &operator=(const LabelTask &) = delete;
@@ -544,6 +552,7 @@ private:
   void prepare_and_insert(Progress &progress);
   const double *recentred();
   bool smooths(const NoiseEstimate &e) const;
+  double label_theta() const;
   void smooth_if_noisy(const double *base, Progress &progress);
   sc_params_t params_;
   std::vector<double> own_;

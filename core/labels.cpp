@@ -6,6 +6,7 @@
 
 #include "delaunay.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numeric>
@@ -107,7 +108,9 @@ public:
   typedef typename DT::Vertex_handle Vh;
   typedef typename DT::Cell_handle Ch;
 
-  explicit Labelling(DT &t) : dt_(t) {}
+  // cocone_theta: the cocone test's, for surface_between(); 0 for none.
+  Labelling(DT &t, double cocone_theta)
+      : dt_(t), sin2_cocone_(std::sin(cocone_theta) * std::sin(cocone_theta)) {}
 
   // Watertight mode: label every cell inside or outside by the shape of
   // the empty balls (weigh()), repair the boundary of the inside cells
@@ -155,6 +158,9 @@ private:
   //    its two weights where it has only one, and their difference less one
   //    where it has both, so that conflicting cells wait. Ties go by the
   //    cells' vertex numbers, not their places in memory.
+  //  - Except across a facet that the surface passes through where the
+  //    sample is coarse (surface_between()): there the balls overlap
+  //    deeply across the surface, and no label crosses by them.
   // A cell no weight reaches stays outside.
   //
   // Weighing reads arrays indexed by the cells' numbers (number_cells()),
@@ -255,7 +261,7 @@ private:
           continue;
         const float w = -crossing(d, b);
         float &same = in ? b.ein : b.eout;
-        if (w > same) {
+        if (w > same && !surface_between(i, f, d, b)) {
           same = w;
           queue.push(Entry{priority(b), j});
         }
@@ -281,6 +287,7 @@ private:
     node_ = {};
     links_ = {};
     hull_poles_ = {};
+    axis_ = {};
     cells_ = {};
     kmin_ = {};
   }
@@ -400,6 +407,17 @@ private:
       }
       p.far2 = -1;
     }
+    // Each sample's pole direction, unit, for surface_between().
+    axis_.assign(3 * m, 0.0f);
+    for (size_t v = 0; v < m; ++v) {
+      const Poles &p = poles[v];
+      const double l2 = double(p.dir[0]) * p.dir[0] +
+                        double(p.dir[1]) * p.dir[1] +
+                        double(p.dir[2]) * p.dir[2];
+      if (l2 > 0)
+        for (int k = 0; k < 3; ++k)
+          axis_[3 * v + k] = float(p.dir[k] / std::sqrt(l2));
+    }
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
       const uint32_t i = c->info().w.local;
       const float *o = node_[i].o;
@@ -470,6 +488,40 @@ private:
                      nrm.y * (b.o[1] - corner[0].y) +
                      nrm.z * (b.o[2] - corner[0].z);
     return float(std::max(-1.0, std::min(1.0, -h / std::sqrt(double(b.r2)))));
+  }
+
+  // Whether the surface passes between finite cells d (number i) and b,
+  // across d's facet f, where the balls cannot tell. In a coarse sample
+  // the ball of a cell can reach through the surface (a cell across a thin
+  // tube or a horn's tip, its centre outside): both circumcentres then
+  // lie on the same side of the facet, and the two balls overlap deeply
+  // although the cells lie on either side. The facet is taken for the
+  // surface's where, besides, its dual Voronoi edge, from one
+  // circumcentre to the other, passes the cocone test at its three samples
+  // (section 6.3, with the poles found here): b does not take d's label by
+  // their balls there. (Corners by number, so that the answer does not
+  // depend on the order of the cell's vertices in memory.)
+  bool surface_between(uint32_t i, int f, const Node &d, const Node &b) const {
+    if (!(sin2_cocone_ > 0) || d.r2 < 0 || b.r2 < 0)
+      return false;
+    const Ch c = cells_[i];
+    Vh v[3] = {c->vertex((f + 1) % 4), c->vertex((f + 2) % 4),
+               c->vertex((f + 3) % 4)};
+    std::sort(v, v + 3,
+              [](Vh x, Vh y) { return x->info().idx < y->info().idx; });
+    const V3 p0 = v3(v[0]->point());
+    const V3 nrm = cross(v3(v[1]->point()) - p0, v3(v[2]->point()) - p0);
+    const V3 od{d.o[0], d.o[1], d.o[2]}, ob{b.o[0], b.o[1], b.o[2]};
+    if (!(dot(nrm, od - p0) * dot(nrm, ob - p0) > 0))
+      return false;
+    for (const Vh &x : v) {
+      const float *a = &axis_[3 * size_t(x->info().idx)];
+      const V3 axis{a[0], a[1], a[2]}, s = v3(x->point());
+      const int side = cone_side(od - s, axis, sin2_cocone_);
+      if (side != 0 && side == cone_side(ob - s, axis, sin2_cocone_))
+        return false;
+    }
+    return true;
   }
 
   // The cosine of the angle at which the spheres of neighbouring cells p
@@ -788,6 +840,8 @@ private:
 private:
   DT &dt_;
   std::vector<Vh> vh_; // vertex number -> handle
+  const double sin2_cocone_;
+  std::vector<float> axis_; // per vertex number: the unit pole direction
   std::vector<Ch> star_; // scratch of repair_vertex()
   std::vector<std::pair<std::array<uint32_t, 4>, Ch>> keyed_; // likewise
   std::vector<uint32_t> parent_, size_;
@@ -806,12 +860,12 @@ private:
 
 template <class DT>
 bool label_and_close(DT &dt, std::vector<uint32_t> &tris, Progress &progress,
-                     sc_diag_t &diag) {
-  return Labelling<DT>(dt).label_and_close(tris, progress, diag);
+                     sc_diag_t &diag, double cocone_theta) {
+  return Labelling<DT>(dt, cocone_theta).label_and_close(tris, progress, diag);
 }
 
 template bool label_and_close<DtSeq>(DtSeq &, std::vector<uint32_t> &,
-                                     Progress &, sc_diag_t &);
+                                     Progress &, sc_diag_t &, double);
 
 } // namespace dt
 } // namespace sc

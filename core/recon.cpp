@@ -54,10 +54,6 @@ constexpr size_t kKeepForLabels = 65536;
 // Auto mode takes a sample for one of a closed surface where no loop is
 // left open wider than this many of its edges (section 11.6).
 constexpr double kClosedLoopWidth = 3;
-// Denoising (and auto mode) smooths the points when the estimated noise
-// is at least this many spacings (README, "Noise"; measured with
-// shortcrust-noise-table and on the shared closed models).
-constexpr double kNoiseFloor = SC_NOISE_FLOOR;
 // The noise estimate runs beside the triangulation on jobs of at least so
 // many points (below, starting a thread costs more than it saves).
 constexpr size_t kEstimateBeside = 1024;
@@ -134,11 +130,11 @@ struct LabelTask::State {
 };
 
 LabelTask::LabelTask(std::unique_ptr<Triangulator> dt, const double *lxyz,
-                     size_t m)
+                     size_t m, double cocone_theta)
     : state_(new State) {
   State &st = *state_;
   st.dt = std::move(dt);
-  st.thread = std::thread([&st, lxyz, m] {
+  st.thread = std::thread([&st, lxyz, m, cocone_theta] {
     // A stop makes the next progress tick throw.
     Progress mine(
         [](void *u, sc_stage_t, double) {
@@ -150,7 +146,7 @@ LabelTask::LabelTask(std::unique_ptr<Triangulator> dt, const double *lxyz,
         st.dt = make_triangulator();
         st.dt->insert(lxyz, 0, m, mine);
       }
-      st.inside = st.dt->close(st.tris, mine, st.diag);
+      st.inside = st.dt->close(st.tris, mine, st.diag, cocone_theta);
     } catch (...) {
       st.error = std::current_exception();
     }
@@ -268,7 +264,7 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
         dt = make_triangulator();
         dt->insert(lxyz, 0, m, progress);
       }
-      if (!dt->close(labelled, progress, da))
+      if (!dt->close(labelled, progress, da, label_theta()))
         return false;
     }
     canonical_order(labelled, true);
@@ -645,9 +641,14 @@ const double *Recon::recentred() {
 // sample resolves its surface, or at any noise when given a scale; auto
 // mode likewise without the scale.
 bool Recon::smooths(const NoiseEstimate &e) const {
-  const bool noisy = e.noise >= kNoiseFloor && e.resolved();
-  return (params_.denoise && (noisy || params_.denoise_scale > 0)) ||
-         (params_.mode == SC_MODE_AUTO && noisy);
+  return (params_.denoise && (e.noisy() || params_.denoise_scale > 0)) ||
+         (params_.mode == SC_MODE_AUTO && e.noisy());
+}
+
+// The cocone test's angle for the labelling (Triangulator::close()): 0,
+// for none, where the points are noisy.
+double Recon::label_theta() const {
+  return noise_.noisy() ? 0 : params_.cocone_theta;
 }
 
 // Smooths a copy of base when the estimate asks for it; work_ is then the
@@ -1078,7 +1079,8 @@ sc_mesh_t *Recon::finish() {
   if ((labels_beside() &&
        (params_.watertight_labels || !f.boundary.empty() || kept_)) ||
       (params_.mode == SC_MODE_AUTO && thread_count() > 1 && kept_))
-    labelling_.reset(new LabelTask(std::move(kept_), lxyz.data(), m));
+    labelling_.reset(
+        new LabelTask(std::move(kept_), lxyz.data(), m, label_theta()));
   const sc_diag_t before_prune = diag;
   std::vector<uint8_t> alive;
   EdgeTablePtr table;

@@ -20,6 +20,10 @@
  * the sample is taken for a closed one, and must be closed as watertight
  * mode closes it, from the surface before its small holes were filled,
  * not with them filled (genus 3: section 11.6): to the same triangles.
+ * The knot and the dino at 2 500 random points: cells across the knot's
+ * tube and in the dino's thin parts have balls that reach through the
+ * surface, by which the labels cut the tube and broke a part off; they
+ * must not cross there (section 11.4, step 3).
  *
  *   test_core_mesh_sample MESH.ply N SEED MODE [patches]
  *
