@@ -177,6 +177,15 @@ struct Criteria {
   }
 };
 
+// A cell is nearly flat where the triple product of its edge vectors from
+// one corner is at most this times the product of their lengths.
+constexpr double kFlatCell = 1e-10;
+
+// The circumcentre of a finite cell, its corners p[0..3] in the order of
+// their numbers (corners_by_number()); a nearly flat cell's is guarded, and
+// sets `guarded` (docs/algorithm.md section 4.1).
+V3 cell_circumcentre(const Point *p, bool &guarded);
+
 // The four vertices of finite cell c into v, in the order of their
 // numbers: how a cell orders its vertices depends on the order of
 // insertion, and what is computed from them in that order would round

@@ -186,10 +186,12 @@ private:
       // the same.
       Vh v[4];
       corners_by_number(c, v);
-      const Point o = CGAL::circumcenter(v[0]->point(), v[1]->point(),
-                                         v[2]->point(), v[3]->point());
-      d.o[0] = float(o.x()), d.o[1] = float(o.y()), d.o[2] = float(o.z());
-      d.r2 = float(CGAL::squared_distance(o, v[0]->point()));
+      const Point p[4] = {v[0]->point(), v[1]->point(), v[2]->point(),
+                          v[3]->point()};
+      bool guarded;
+      const V3 o = cell_circumcentre(p, guarded);
+      d.o[0] = o.x, d.o[1] = o.y, d.o[2] = o.z;
+      d.r2 = norm2(o - v3(p[0]));
     }
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
       if (dt_.is_infinite(c)) {
@@ -330,8 +332,8 @@ private:
   // What weighing reads of a cell, together.
   struct Node {
     uint32_t nbr[4];  // the neighbours' numbers
-    float o[3];       // the circumcentre
-    float r2;         // squared radius; negative for an infinite cell
+    double o[3];      // the circumcentre
+    double r2;        // squared radius; negative for an infinite cell
     float ein = 0, eout = 0; // the evidence for inside, and for outside
     uint32_t link_at = 0;    // its first pole link (links_)
     uint8_t links = 0;       // and how many (at most one a vertex)
@@ -401,7 +403,7 @@ private:
         p.first = UINT32_MAX;
       } else if (p.first != UINT32_MAX) {
         const Point &s = vh_[v]->point();
-        const float *o = node_[p.first].o;
+        const double *o = node_[p.first].o;
         p.dir[0] = float(o[0] - s.x()), p.dir[1] = float(o[1] - s.y()),
         p.dir[2] = float(o[2] - s.z());
       }
@@ -420,7 +422,7 @@ private:
     }
     for (auto c = dt_.finite_cells_begin(); c != dt_.finite_cells_end(); ++c) {
       const uint32_t i = c->info().w.local;
-      const float *o = node_[i].o;
+      const double *o = node_[i].o;
       poll(i);
       for (int j = 0; j < 4; ++j) {
         Poles &p = poles[c->vertex(j)->info().idx];
@@ -533,22 +535,22 @@ private:
       return -1;
     if (p.r2 < 0 || q.r2 < 0)
       return p.r2 < 0 ? p.o[0] : q.o[0];
-    float d2 = 0;
+    double d2 = 0;
     for (int k = 0; k < 3; ++k)
       d2 += (p.o[k] - q.o[k]) * (p.o[k] - q.o[k]);
-    const float den = 2 * std::sqrt(p.r2 * q.r2);
+    const double den = 2 * std::sqrt(p.r2 * q.r2);
     if (!(den > 0))
       return 0;
-    return std::max(-1.0f, std::min(1.0f, (d2 - p.r2 - q.r2) / den));
+    return float(std::max(-1.0, std::min(1.0, (d2 - p.r2 - q.r2) / den)));
   }
 
-  static float dist2(const Point &s, const float o[3]) {
+  static float dist2(const Point &s, const double o[3]) {
     const float a[3] = {float(o[0] - s.x()), float(o[1] - s.y()),
                         float(o[2] - s.z())};
     return a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
   }
   // The cosine of the angle at sample s between direction a and point o.
-  static float cos_at(const Point &s, const float a[3], const float o[3]) {
+  static float cos_at(const Point &s, const float a[3], const double o[3]) {
     const float b[3] = {float(o[0] - s.x()), float(o[1] - s.y()),
                         float(o[2] - s.z())};
     const float aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];

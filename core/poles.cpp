@@ -12,38 +12,67 @@
 
 namespace sc {
 namespace dt {
-namespace {
 
-// Circumcentre of a tetrahedron. Nearly flat cells (cospherical points on
-// grid-like scans) give a centre that is huge or not finite; those fall back
-// to the circumcentre of their largest facet and set `guarded`.
-V3 cell_circumcentre(V3 a, V3 b, V3 c, V3 d, bool &guarded) {
+// A nearly flat cell's power (below) at most this times the squared radius
+// of its largest facet's circle: its four points are taken for points of
+// one circle, as on grids and rings of samples, whose rounding gives
+// powers many orders of magnitude smaller.
+constexpr double kCocircular = 1e-6;
+
+V3 cell_circumcentre(const Point *p, bool &guarded) {
+  const V3 a = v3(p[0]), b = v3(p[1]), c = v3(p[2]), d = v3(p[3]);
   V3 u = b - a, v = c - a, w = d - a;
   V3 vw = cross(v, w);
   double det = dot(u, vw);
   double scale = std::sqrt(norm2(u) * norm2(v) * norm2(w));
   guarded = false;
-  if (std::fabs(det) > 1e-10 * scale) {
+  if (std::fabs(det) > kFlatCell * scale) {
     V3 num = norm2(u) * vw + norm2(v) * cross(w, u) + norm2(w) * cross(u, v);
     V3 cc = a + (0.5 / det) * num;
     if (finite(cc))
       return cc;
   }
   guarded = true;
-  const V3 p[4] = {a, b, c, d};
+  const V3 q[4] = {a, b, c, d};
   double best = -1;
+  int facet = -1;
   V3 out = 0.25 * (a + b + c + d);
   for (int i = 0; i < 4; ++i) {
-    V3 x = p[(i + 1) % 4], y = p[(i + 2) % 4], z = p[(i + 3) % 4];
+    V3 x = q[(i + 1) % 4], y = q[(i + 2) % 4], z = q[(i + 3) % 4];
     double area2 = norm2(cross(y - x, z - x));
     V3 cc;
     if (area2 > best && tri_circumcentre(x, y, z, cc)) {
       best = area2;
       out = cc;
+      facet = i;
     }
   }
-  return out;
+  if (facet < 0)
+    return out;
+  // Off the circle of that facet, the fourth point puts the centre far
+  // along the facet's normal, t = power / (2 h) from its circle's centre
+  // (power: the fourth point's against the facet's smallest sphere; h: its
+  // height over the facet), on the side that the signs of the two give,
+  // the height's taken exactly. The height is too small to measure: the
+  // distance is the least it can be under the guard. On one circle, or in
+  // one plane exactly, the facet's circumcentre stands.
+  const int i = facet;
+  const V3 x = q[(i + 1) % 4], y = q[(i + 2) % 4], z = q[(i + 3) % 4];
+  const double r2 = norm2(out - x), power = norm2(q[i] - out) - r2;
+  if (!(std::fabs(power) > kCocircular * r2))
+    return out;
+  const CGAL::Orientation side =
+      CGAL::orientation(p[(i + 1) % 4], p[(i + 2) % 4], p[(i + 3) % 4], p[i]);
+  if (side == CGAL::COPLANAR)
+    return out;
+  const V3 nrm = cross(y - x, z - x);
+  const double len = std::sqrt(norm2(nrm));
+  const double t = power * len / (2 * kFlatCell * scale);
+  const V3 far = out + ((side == CGAL::POSITIVE ? t : -t) / len) * nrm;
+  return finite(far) ? far : out;
 }
+
+namespace {
 
 // The circumcentre of cell c (counting a guarded one in diag, if given).
 template <class DT>
@@ -54,8 +83,9 @@ V3 centre(typename DT::Cell_handle c, sc_diag_t *diag) {
   Vh v[4];
   corners_by_number(c, v);
   bool guarded;
-  V3 cc = cell_circumcentre(v3(v[0]->point()), v3(v[1]->point()),
-                            v3(v[2]->point()), v3(v[3]->point()), guarded);
+  const Point p[4] = {v[0]->point(), v[1]->point(), v[2]->point(),
+                      v[3]->point()};
+  V3 cc = cell_circumcentre(p, guarded);
   if (guarded && diag)
     ++diag->degenerate_cells;
   return cc;

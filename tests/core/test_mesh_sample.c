@@ -23,9 +23,15 @@
  * The knot and the dino at 2 500 random points: cells across the knot's
  * tube and in the dino's thin parts have balls that reach through the
  * surface, by which the labels cut the tube and broke a part off; they
- * must not cross there (section 11.4, step 3).
+ * must not cross there (section 11.4, step 3). The eight (634 flat
+ * triangles) and the fandisk (flat faces) at 4 000 random points: the
+ * points of a face are coplanar but for rounding, and its flat cells must
+ * have their centres far off the face (section 4.1), not in it, where
+ * every facet of a flat cell passed the cocone test (the eight: genus 3
+ * to 6, in pieces) and the labels' balls tunnelled along the faces (the
+ * fandisk: genus 6 to 10 with --labels).
  *
- *   test_core_mesh_sample MESH.ply N SEED MODE [patches]
+ *   test_core_mesh_sample MESH.ply N SEED MODE [patches|labels]
  *
  * Copyright (C) 2026 the shortcrust authors.
  * SPDX-License-Identifier: GPL-3.0-or-later
@@ -41,7 +47,8 @@
 
 int main(int argc, char **argv) {
   if (argc != 5 && argc != 6) {
-    fprintf(stderr, "usage: %s MESH.ply N SEED MODE [patches]\n", argv[0]);
+    fprintf(stderr, "usage: %s MESH.ply N SEED MODE [patches|labels]\n",
+            argv[0]);
     return 2;
   }
   const size_t n = strtoul(argv[2], NULL, 10);
@@ -49,12 +56,15 @@ int main(int argc, char **argv) {
   sc_params_t p;
   sc_params_init(&p);
   p.mode = sct_mode_from_name(argv[4]);
+  const char *option = argc == 6 ? argv[5] : "";
   if (p.mode == SC_MODE_COUNT_ || n < 100 ||
-      (argc == 6 && strcmp(argv[5], "patches") != 0)) {
+      (argc == 6 && strcmp(option, "patches") != 0 &&
+       strcmp(option, "labels") != 0)) {
     fprintf(stderr, "unknown mode or option, or too few points\n");
     return 2;
   }
-  p.watertight_patches = argc == 6;
+  p.watertight_patches = strcmp(option, "patches") == 0;
+  p.watertight_labels = strcmp(option, "labels") == 0;
   scf_points_t mesh = {0};
   uint32_t *tri = NULL;
   size_t ntri = 0;
@@ -76,8 +86,8 @@ int main(int argc, char **argv) {
   const int genus = (int)truth.genus_total;
   EXPECT_EQ(scs_sample_mesh(mesh.xyz, mesh.count, tri, ntri, n, seed, xyz), 0);
   char what[512];
-  snprintf(what, sizeof what, "%s, %zu random points, %s%s", argv[1], n,
-           argv[4], argc == 6 ? " --patches" : "");
+  snprintf(what, sizeof what, "%s, %zu random points, %s%s%s", argv[1], n,
+           argv[4], argc == 6 ? " --" : "", option);
   sc_mesh_t *one = sct_expect_closed(xyz, n, &p, genus, 1, what);
   /* On two threads (the labelling beside the extraction, the probes of
    * the small handles in slices): the same triangles and cuts. */
