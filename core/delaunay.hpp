@@ -201,6 +201,17 @@ template <class Ch, class Vh> void corners_by_number(Ch c, Vh (&v)[4]) {
   order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
 }
 
+// The circumcentre of finite cell c, from its corners in the order of their
+// numbers (on nearly flat cells the rounding of the centre is enough to
+// change the surface), as cell_circumcentre() gives it.
+template <class Ch> V3 cell_circumcentre(Ch c, bool &guarded) {
+  decltype(c->vertex(0)) v[4];
+  corners_by_number(c, v);
+  const Point p[4] = {v[0]->point(), v[1]->point(), v[2]->point(),
+                      v[3]->point()};
+  return cell_circumcentre(p, guarded);
+}
+
 // Outward unit normal of the hull facet of infinite cell c (its infinite
 // vertex is vertex inf).
 template <class Ch> V3 hull_normal(Ch c, int inf, V3 *pts) {

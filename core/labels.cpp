@@ -181,17 +181,13 @@ private:
         d.nbr[f] = c->neighbor(f)->info().w.local;
       if (dt_.is_infinite(c))
         continue; // after the finite ones, below
-      // The corners in the order of their numbers, so that the labels of
-      // a triangulation built again, in tiles or in a daemon's chunks, are
-      // the same.
-      Vh v[4];
-      corners_by_number(c, v);
-      const Point p[4] = {v[0]->point(), v[1]->point(), v[2]->point(),
-                          v[3]->point()};
+      // From the corners in the order of their numbers, so that the labels
+      // of a triangulation built again, in tiles or in a daemon's chunks,
+      // are the same; the radius to the first of them.
       bool guarded;
-      const V3 o = cell_circumcentre(p, guarded);
+      const V3 o = cell_circumcentre(c, guarded);
       d.o[0] = o.x, d.o[1] = o.y, d.o[2] = o.z;
-      d.r2 = norm2(o - v3(p[0]));
+      d.r2 = norm2(o - v3(vh_[kmin_[c->info().w.local]]->point()));
     }
     for (auto c = dt_.all_cells_begin(); c != dt_.all_cells_end(); ++c)
       if (dt_.is_infinite(c)) {

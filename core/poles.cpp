@@ -75,17 +75,9 @@ V3 cell_circumcentre(const Point *p, bool &guarded) {
 namespace {
 
 // The circumcentre of cell c (counting a guarded one in diag, if given).
-template <class DT>
-V3 centre(typename DT::Cell_handle c, sc_diag_t *diag) {
-  typedef typename DT::Vertex_handle Vh;
-  // Taken in the order of the vertex numbers: on nearly flat cells the
-  // rounding of the centre is enough to change the surface.
-  Vh v[4];
-  corners_by_number(c, v);
+template <class DT> V3 centre(typename DT::Cell_handle c, sc_diag_t *diag) {
   bool guarded;
-  const Point p[4] = {v[0]->point(), v[1]->point(), v[2]->point(),
-                      v[3]->point()};
-  V3 cc = cell_circumcentre(p, guarded);
+  const V3 cc = cell_circumcentre(c, guarded);
   if (guarded && diag)
     ++diag->degenerate_cells;
   return cc;
