@@ -49,6 +49,11 @@ constexpr uint32_t kUnchecked = 0;
 // A cell's own search for a point in its ball reads at most this many
 // leaves of the tree before it leaves the cell to the sweep (certify()).
 constexpr size_t kLeafBudget = 48;
+// ... or once it has met this many points on the cell's sphere (to
+// rounding), where the filters fail and each test is exact: on samples of
+// a sphere, whose inner balls all pass near every sample, the leaves' worth
+// of exact tests made tiles cost 50 to 200 times one triangulation.
+constexpr size_t kOnSphere = 4;
 // A tile that takes in more foreign points than this many times its own,
 // or whose certification costs more than this many leaves of the tree (see
 // kCellCost below) for each point it owns, gives up, and the job runs on
@@ -72,6 +77,10 @@ struct OverLimit {
 // cell's own search without a budget, about (with the cells that the
 // points it finds make), and the sweep, for each point it locates.
 constexpr double kCellCost = 256;
+// Once this many cells have searched alone, a mean cost above twice
+// what the choice between searching and sweeping assumed makes the choice
+// again (certify()).
+constexpr size_t kCostSample = 4;
 constexpr double kSweepCost = 512;
 // ... and a point's test against a cell's ball (exact when it is nearly on
 // the sphere, as all are in a sample of a sphere).
@@ -746,8 +755,9 @@ inline bool wanted_cell(const Wanted &want, Ch c) {
 }
 
 // Checks finite cell c of tile t (see certify()), reading at most `leaves`
-// leaves of the tree; a point that makes it wrong goes into add. True when
-// the check needed more leaves and found no such point: it is the sweep's.
+// leaves of the tree, and (with a budget) meeting at most kOnSphere points
+// on its sphere; a point that makes it wrong goes into add. True when the
+// check needed more and found no such point: it is the sweep's.
 bool check_cell(const Shared &s, Tile &t, const Ownership &own,
                 const Wanted &want, Ch c, std::vector<uint32_t> &add,
                 size_t leaves) {
@@ -765,6 +775,7 @@ bool check_cell(const Shared &s, Tile &t, const Ownership &own,
   // the cell, and the cells it makes are checked in the next round.
   // (Taking every point inside a wrong ball, which may be far larger than
   // any cell of all, took in most of the other tiles.)
+  size_t on_sphere = 0;
   const uint32_t best = s.tree->nearest_in_ball(
       centre, r2, t.reach.lo, t.reach.hi,
       [&](uint32_t v) {
@@ -772,9 +783,14 @@ bool check_cell(const Shared &s, Tile &t, const Ownership &own,
           return false;
         t.work += kTestCost;
         const double *q = s.pts + 3 * size_t(v);
-        return CGAL::side_of_bounded_sphere(p0, p1, p2, p3,
-                                            Point(q[0], q[1], q[2])) !=
-               CGAL::ON_UNBOUNDED_SIDE;
+        const bool in = CGAL::side_of_bounded_sphere(p0, p1, p2, p3,
+                                                     Point(q[0], q[1], q[2])) !=
+                        CGAL::ON_UNBOUNDED_SIDE;
+        // A point the distance puts in the ball and the predicate outside
+        // is on its sphere, to rounding: past a few, the budget is spent.
+        if (!in && ++on_sphere > kOnSphere && budget != SIZE_MAX)
+          leaves = 0;
+        return in;
       },
       leaves);
   t.work += double(budget - leaves);
@@ -947,7 +963,8 @@ bool in_wanted_ball(const DtSeq &dt, const Point &p, Ch c, const Wanted &want,
 // A ball that the surface touches along a whole circle (the inner balls
 // of a closed surface's samples) has many points just outside it, and the
 // tree reads them all, for each such cell. So a cell's own search stops
-// after kLeafBudget leaves, and the cells left open are certified
+// after kLeafBudget leaves (or kOnSphere points found on its sphere, each
+// test exact), and the cells left open are certified
 // together by a sweep over the points instead: each point the tile lacks
 // within reach of an open ball, nearest the tile first, is located in the
 // tile's triangulation and goes in when it conflicts with a wanted cell.
@@ -1054,6 +1071,10 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
       });
       return most;
     };
+    // What a cell's own search has cost so far, on average: far more than
+    // kCellCost where many points lie nearly on the balls' spheres.
+    double cell_cost = kCellCost, searched_work = 0;
+    size_t searched = 0;
     // Sweeps the points within `extent` of the reach (see above), in
     // bands of distance, and in each band in vertex order, which is a
     // Hilbert order: each point is located near the one before.
@@ -1128,7 +1149,8 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
         continue;
       }
       // The open balls that reach farthest search alone, the others are
-      // swept: as many of each as cost the least.
+      // swept: as many of each as cost the least, a search costing what
+      // the searches so far did on average (kCellCost at least).
       std::sort(
           open.begin(), open.end(),
           [](const std::pair<double, Ch> &a, const std::pair<double, Ch> &b) {
@@ -1136,7 +1158,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
           });
       const size_t inside = s.tree->count_in_box(t.reach.lo, t.reach.hi);
       auto cost = [&](size_t alone) {
-        double c = kCellCost * double(alone);
+        double c = cell_cost * double(alone);
         if (alone < open.size()) {
           const Box out = grown(t.reach, open[alone].first);
           c += kSweepCost *
@@ -1151,14 +1173,26 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
         if (c < least)
           least = c, first = i;
       }
-      for (size_t i = 0; i < first; ++i) {
+      // Where the searches cost more than twice what the choice assumed
+      // (their balls' spheres hold many points: each search reads them
+      // all), the choice is made again with what they did cost.
+      const double modelled = cell_cost;
+      bool dearer = false;
+      for (size_t i = 0; i < first && !dearer; ++i) {
         const size_t found = add.size();
+        const double before = t.work;
         set_mark(open[i].second, marks.checked);
         (void)check_cell(s, t, own, want, open[i].second, add, SIZE_MAX);
         if (add.size() > found)
           set_mark(open[i].second, kUnchecked);
+        ++searched;
+        searched_work += t.work - before;
+        cell_cost = std::max(kCellCost, searched_work / double(searched));
+        dearer = searched >= kCostSample && cell_cost > 2 * modelled;
         too_many();
       }
+      if (dearer && add.empty())
+        continue;
       if (!add.empty()) {
         drain();
         continue;

@@ -3,13 +3,12 @@
  * tiles, run on one thread or two, give exactly the triangles, normals and
  * counts of one triangulation, in the cocone and shortcrust modes, on a
  * synthetic sample, a real scan, a grid (cospherical everywhere, flat hull
- * faces) and a very uneven density; a cancel during the tiles stops them
- * all; the modes that run one triangulation say so (tiles 0); points
- * smoothed on two threads are smoothed as on one. A FILE that is a mesh is
- * sampled at 6000 random points over its surface. Each tile
- * run as a job of its own (tile_count, tile_index) and merged
- * (sc_reconstruct_merge()) gives the same, and results that cannot be one
- * job's tiles are refused.
+ * faces), an exact sample of a sphere and a very uneven density; a cancel
+ * during the tiles stops them all; the modes that run one triangulation say so
+ * (tiles 0); points smoothed on two threads are smoothed as on one. A FILE that
+ * is a mesh is sampled at 6000 random points over its surface. Each tile run as
+ * a job of its own (tile_count, tile_index) and merged (sc_reconstruct_merge())
+ * gives the same, and results that cannot be one job's tiles are refused.
  *
  *   test_core_tiles [SCAN.ply|MESH.ply ...]
  *   test_core_tiles --files SCAN.ply|MESH.ply ...   (only those)
@@ -423,6 +422,14 @@ int main(int argc, char **argv) {
     if (xyz[3 * i] < 0.5 || i % 40 == 0)
       memmove(&xyz[3 * kept++], &xyz[3 * i], 3 * sizeof *xyz);
   check("uneven genus-2", xyz, kept, 0);
+
+  /* An exact sample of a sphere: every inner ball is nearly the sphere
+   * itself and every sample nearly on it, so that the filters fail and
+   * each test of a sample against such a ball is exact. */
+  EXPECT_EQ(scs_sample_surface(SCS_SURF_SPHERE, SCS_DENSITY_UNIFORM_RANDOM,
+                               6000, 3, xyz),
+            0);
+  check("sphere", xyz, 6000, 0);
 
   /* A grid: the surface of a box of 61 x 41 x 21 points on every face. */
   kept = 0;
