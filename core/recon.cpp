@@ -494,7 +494,8 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
 
 // Auto mode (section 11.6): whether to close surf as watertight mode does.
 // Where it is one closed piece, there is nothing to close (samples left
-// out are attached afterwards; bubbles were dropped). Otherwise the sample is
+// out are attached afterwards; bubbles were dropped), unless it leaves out
+// more samples than watertight mode trusts. Otherwise the sample is
 // taken for one of a closed surface when every loop left open, once the small
 // holes and the slits are filled, is narrow: a strip or a few triangles the
 // candidate tests missed (the closed models measured: 2.1 edges wide at most),
@@ -506,8 +507,11 @@ bool Recon::auto_closes(const double *lxyz, size_t m, const Surface &surf,
                         const sc_diag_t &diag, Progress &progress) const {
   if (params_.mode != SC_MODE_AUTO || surf.tris.empty())
     return false;
+  // One closed piece is closed again where watertight mode would doubt it
+  // (close_surface()): no boundary sample was found, and it leaves out
+  // more than one sample in a thousand before they are attached.
   if (diag.closed && diag.components == 1)
-    return false;
+    return diag.boundary_samples == 0 && 1000 * diag.samples_unused > m;
   return widest_loop(lxyz, m, surf.tris, progress) <= kClosedLoopWidth;
 }
 
