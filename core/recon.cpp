@@ -107,6 +107,12 @@ struct Closure {
   }
 };
 
+// Whether `unused` of m samples is more than the project's target allows:
+// one in a thousand.
+inline bool too_many_unused(uint64_t unused, size_t m) {
+  return 1000 * unused > m;
+}
+
 // The corners of triangle k of tris, in increasing order.
 inline std::array<uint32_t, 3> sorted_corners(const std::vector<uint32_t> &tris,
                                               size_t k) {
@@ -315,7 +321,7 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
   auto doubtful = [&] {
     const Closure c(diag);
     return !c.ok || c.loops > 0 || pieces(surf) != 1 || diag.handles_cut > 0 ||
-           1000 * c.unused > m;
+           too_many_unused(c.unused, m);
   };
   const bool labelling =
       labels_only || (patches_first ? !Closure(diag).ok : doubtful());
@@ -458,7 +464,7 @@ void Recon::close_surface(const double *lxyz, size_t m, bool cut,
     Surface sa = s;
     sc_diag_t dc = d;
     attach_samples(lxyz, m, sa, progress, dc);
-    if (1000 * dc.samples_unused > m)
+    if (too_many_unused(dc.samples_unused, m))
       return;
     surf = std::move(s);
     diag = d;
@@ -511,7 +517,8 @@ bool Recon::auto_closes(const double *lxyz, size_t m, const Surface &surf,
   // (close_surface()): no boundary sample was found, and it leaves out
   // more than one sample in a thousand before they are attached.
   if (diag.closed && diag.components == 1)
-    return diag.boundary_samples == 0 && 1000 * diag.samples_unused > m;
+    return diag.boundary_samples == 0 &&
+           too_many_unused(diag.samples_unused, m);
   return widest_loop(lxyz, m, surf.tris, progress) <= kClosedLoopWidth;
 }
 

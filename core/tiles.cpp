@@ -1071,10 +1071,14 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
       });
       return most;
     };
-    // What a cell's own search has cost so far, on average: far more than
-    // kCellCost where many points lie nearly on the balls' spheres.
-    double cell_cost = kCellCost, searched_work = 0;
+    // What a cell's own search has cost so far, on average (kCellCost at
+    // least): far more where many points lie nearly on the balls' spheres.
+    double searched_work = 0;
     size_t searched = 0;
+    auto cell_cost = [&] {
+      return searched ? std::max(kCellCost, searched_work / double(searched))
+                      : kCellCost;
+    };
     // Sweeps the points within `extent` of the reach (see above), in
     // bands of distance, and in each band in vertex order, which is a
     // Hilbert order: each point is located near the one before.
@@ -1150,7 +1154,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
       }
       // The open balls that reach farthest search alone, the others are
       // swept: as many of each as cost the least, a search costing what
-      // the searches so far did on average (kCellCost at least).
+      // the searches so far did (cell_cost()).
       std::sort(
           open.begin(), open.end(),
           [](const std::pair<double, Ch> &a, const std::pair<double, Ch> &b) {
@@ -1158,7 +1162,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
           });
       const size_t inside = s.tree->count_in_box(t.reach.lo, t.reach.hi);
       auto cost = [&](size_t alone) {
-        double c = cell_cost * double(alone);
+        double c = cell_cost() * double(alone);
         if (alone < open.size()) {
           const Box out = grown(t.reach, open[alone].first);
           c += kSweepCost *
@@ -1176,7 +1180,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
       // Where the searches cost more than twice what the choice assumed
       // (their balls' spheres hold many points: each search reads them
       // all), the choice is made again with what they did cost.
-      const double modelled = cell_cost;
+      const double modelled = cell_cost();
       bool dearer = false;
       for (size_t i = 0; i < first && !dearer; ++i) {
         const size_t found = add.size();
@@ -1187,8 +1191,7 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
           set_mark(open[i].second, kUnchecked);
         ++searched;
         searched_work += t.work - before;
-        cell_cost = std::max(kCellCost, searched_work / double(searched));
-        dearer = searched >= kCostSample && cell_cost > 2 * modelled;
+        dearer = searched >= kCostSample && cell_cost() > 2 * modelled;
         too_many();
       }
       if (dearer && add.empty())
