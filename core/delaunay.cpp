@@ -317,9 +317,10 @@ public:
                   sizeof v->info().pole);
     // The triangulation is not needed any more: free it before pruning so
     // that the peak memory is the triangulation's alone (watertight mode
-    // keeps it for the labelling with --labels, and where boundary
-    // samples were found, so that the labelling may well run).
-    if (!keep && keep_if_boundary && diag.boundary_samples > 0)
+    // keeps it for the labelling with --labels, and where enough boundary
+    // samples were found that the labelling may well run).
+    if (!keep && keep_if_boundary && diag.boundary_samples > 0 &&
+        diag.boundary_samples >= keep_boundary_samples)
       keep = true;
     if (!keep)
       dt_.clear();
