@@ -55,7 +55,7 @@ constexpr size_t kKeepForLabels = 65536;
 // boundary sample: there the patches have left doubt and the labelling
 // has run on every input measured (0.8% to 17% of the samples boundary
 // samples), and the triangulation kept is the one it labels, for the same
-// peak memory and a quarter less time than building it again; below (5
+// peak memory and 11% to 27% less time than building it again; below (5
 // to 8 boundary samples of 200 000 on noisy synthetic samples) the
 // patches sufficed, and keeping it would have raised the peak by 60%.
 constexpr size_t kKeepBoundaryShare = 1000;
