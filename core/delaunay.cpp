@@ -319,8 +319,8 @@ public:
     // that the peak memory is the triangulation's alone (watertight mode
     // keeps it for the labelling with --labels, and where enough boundary
     // samples were found that the labelling may well run).
-    if (!keep && keep_if_boundary && diag.boundary_samples > 0 &&
-        diag.boundary_samples >= keep_boundary_samples)
+    if (!keep && diag.boundary_samples > 0 &&
+        diag.boundary_samples >= keep_from_boundary)
       keep = true;
     if (!keep)
       dt_.clear();

@@ -181,11 +181,10 @@ public:
   // triangulation of its points, cell for cell.
   virtual void translate(const double shift[3]) = 0;
   // filter() keeps the triangulation for close() instead of freeing it;
-  // or, with keep_if_boundary, where at least keep_boundary_samples
-  // vertices are boundary samples, and then sets keep.
+  // or where at least keep_from_boundary vertices are boundary samples
+  // (SIZE_MAX: never), and then sets keep.
   bool keep = false;
-  bool keep_if_boundary = false;
-  size_t keep_boundary_samples = 1;
+  size_t keep_from_boundary = SIZE_MAX;
 };
 
 // Section 3.4: sets shift to the lower corner of the points' box on each

@@ -1052,21 +1052,19 @@ sc_mesh_t *Recon::finish() {
     const bool closing = params_.mode == SC_MODE_WATERTIGHT;
     const bool small = n_ <= kKeepForLabels;
     dt_->keep = closing && params_.watertight_labels;
-    dt_->keep_if_boundary =
-        ((closing || params_.mode == SC_MODE_AUTO) && small) ||
-        (closing && !params_.watertight_patches);
-    dt_->keep_boundary_samples =
-        small ? 1 : (n_ + kKeepBoundaryShare - 1) / kKeepBoundaryShare;
+    dt_->keep_from_boundary =
+        (closing || params_.mode == SC_MODE_AUTO) && small ? 1
+        : closing && !params_.watertight_patches
+            ? (n_ + kKeepBoundaryShare - 1) / kKeepBoundaryShare
+            : SIZE_MAX;
     // On more threads, wherever a boundary sample is found, and always
     // where it is small: the labelling then runs beside the extraction
     // (LabelTask), on it, and stops where the patches settle the closure.
     // (The small ones without a boundary sample that the patches leave in
     // doubt, such as the cheese, no longer wait for it to be built again:
     // 4.36 to 2.96-3.40 times CGAL's construction on two threads.)
-    if (labels_beside() && !params_.watertight_labels) {
-      dt_->keep_if_boundary = true;
-      dt_->keep_boundary_samples = 1;
-    }
+    if (labels_beside() && !params_.watertight_labels)
+      dt_->keep_from_boundary = 1;
     if (labels_beside() && small)
       dt_->keep = true;
     dt_->filter(work, n_, params_, progress, f, diag, seconds_);

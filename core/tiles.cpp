@@ -1145,16 +1145,16 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
     size_t cells = t.dt.number_of_cells(), k = 0;
     if (give_up && cells >= kSampleStride * kLeastSample) {
       const double before = t.work;
-      size_t sampled = 0;
+      size_t finite = 0, sampled = 0;
       for_cells(t.dt, false, [&](Ch c) {
-        if (k++ % kSampleStride == 0) {
+        if (finite++ % kSampleStride == 0) {
           check(c);
           ++sampled;
         }
       });
-      if ((t.work - before) * double(k) / double(sampled) > most_work)
+      if (sampled >= kLeastSample &&
+          (t.work - before) * double(finite) / double(sampled) > most_work)
         throw NotTileable{t.foreign};
-      k = 0;
     }
     for_cells(t.dt, false, [&](Ch c) {
       progress.tick(k++, cells);
