@@ -40,10 +40,78 @@ struct XyzMap {
 
 } // namespace
 
+namespace {
+
+typedef CGAL::Spatial_sort_traits_adapter_3<K, XyzMap> SortTraits;
+template <int axis, bool up>
+using HilbertCmp = CGAL::internal::Hilbert_cmp_3<SortTraits, axis, up>;
+
+} // namespace
+
+// As CGAL::hilbert_sort() sorts (hilbert_sort.h, Hilbert_sort_median_3.h):
+// a shuffle by rand48 with its default seed, then the first level of the
+// recursion, its seven splits at the median and its eight sorts, whose
+// axes and directions are those of the level's call with x the first axis
+// and nothing reversed.
+void HilbertSort::split() {
+  boost::rand48 random;
+  boost::random_number_generator<boost::rand48, std::ptrdiff_t> rng(random);
+  CGAL::cpp98::random_shuffle(idx_.begin(), idx_.end(), rng);
+  const SortTraits t{XyzMap{xyz_}};
+  const auto b = idx_.begin();
+  auto at = [&](size_t i) { return b + std::ptrdiff_t(cut_[i]); };
+  auto cut = [&](size_t i, size_t lo, size_t hi, auto cmp) {
+    cut_[i] = size_t(CGAL::internal::hilbert_split(at(lo), at(hi), cmp) - b);
+  };
+  cut_[0] = 0;
+  cut_[8] = idx_.size();
+  if (idx_.size() <= 1) {
+    for (size_t i = 1; i < 8; ++i)
+      cut_[i] = idx_.size();
+    return;
+  }
+  cut(4, 0, 8, HilbertCmp<0, false>(t));
+  cut(2, 0, 4, HilbertCmp<1, false>(t));
+  cut(1, 0, 2, HilbertCmp<2, false>(t));
+  cut(3, 2, 4, HilbertCmp<2, true>(t));
+  cut(6, 4, 8, HilbertCmp<1, true>(t));
+  cut(5, 4, 6, HilbertCmp<2, false>(t));
+  cut(7, 6, 8, HilbertCmp<2, true>(t));
+}
+
+void HilbertSort::part(size_t i) {
+  std::call_once(split_once_, [this] { split(); });
+  const CGAL::Hilbert_sort_median_3<SortTraits, CGAL::Sequential_tag> sort(
+      SortTraits{XyzMap{xyz_}});
+  const auto b = idx_.begin() + std::ptrdiff_t(cut_[i]),
+             e = idx_.begin() + std::ptrdiff_t(cut_[i + 1]);
+  switch (i) {
+  case 0:
+    sort.recursive_sort<2, false, false, false>(b, e);
+    break;
+  case 1:
+  case 2:
+    sort.recursive_sort<1, false, false, false>(b, e);
+    break;
+  case 3:
+  case 4:
+    sort.recursive_sort<0, false, true, true>(b, e);
+    break;
+  case 5:
+  case 6:
+    sort.recursive_sort<1, true, false, true>(b, e);
+    break;
+  default:
+    sort.recursive_sort<2, true, true, false>(b, e);
+    break;
+  }
+}
+
 void hilbert_sort(const double *xyz, std::vector<uint32_t> &idx) {
-  CGAL::hilbert_sort(idx.begin(), idx.end(),
-                     CGAL::Spatial_sort_traits_adapter_3<K, XyzMap>(
-                         XyzMap{xyz}));
+  HilbertSort sort(xyz, std::move(idx));
+  for (size_t i = 0; i < HilbertSort::kParts; ++i)
+    sort.part(i);
+  idx = sort.take();
 }
 
 std::vector<uint32_t> hilbert_order(const double *xyz, size_t n) {

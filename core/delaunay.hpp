@@ -34,6 +34,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <type_traits>
 #include <vector>
 
@@ -293,8 +294,30 @@ std::vector<typename DT::Cell_iterator> cell_slices(DT &dt, size_t k) {
   return bounds;
 }
 
-// Sorts point indices along a Hilbert curve of their points (CGAL's median
-// policy).
+// A sort of point indices along a Hilbert curve of their points: CGAL's
+// hilbert_sort() with its median policy (the same shuffle, the same
+// splits, the same order), in parts that may run on threads. The first
+// part() to run makes the shuffle and the first level's splits (the others
+// wait for it); each then sorts an eighth of the indices alone. The order
+// does not depend on which parts run where, or when.
+class HilbertSort {
+public:
+  static constexpr size_t kParts = 8;
+  HilbertSort(const double *xyz, std::vector<uint32_t> idx)
+      : xyz_(xyz), idx_(std::move(idx)) {}
+  void part(size_t i);
+  // The sorted indices, once every part has run.
+  std::vector<uint32_t> take() { return std::move(idx_); }
+
+private:
+  void split();
+  const double *xyz_;
+  std::vector<uint32_t> idx_;
+  std::once_flag split_once_;
+  size_t cut_[kParts + 1] = {};
+};
+// Sorts point indices along a Hilbert curve of their points (HilbertSort,
+// on this thread).
 void hilbert_sort(const double *xyz, std::vector<uint32_t> &idx);
 // The indices 0 .. n-1 of the points in Hilbert order (resident at once:
 // prefault.hpp).

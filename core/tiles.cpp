@@ -1574,13 +1574,22 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
     distinct_points(xyz, n, is_vertex, out.dups);
   } else {
     // The Hilbert order of all the points, which numbers the vertices,
-    // is sorted beside the tiles: it reads only the points.
-    run_parallel(k + 1, threads, progress, [&](size_t i, Progress &p) {
-      if (i == 0)
-        sorted = hilbert_order(xyz, n);
-      else
-        triangulate_own(xyz, ts[i - 1], p);
-    });
+    // is sorted beside the tiles, in parts: it reads only the points. The
+    // parts come last, for the threads that finish their tiles first (on
+    // 2 threads and the 1.09M points of the merged scans three times over,
+    // 0.2 s less than the whole sort beside one tile, of 2.7 to 3.0 s).
+    reserve_resident(sorted, n);
+    sorted.resize(n);
+    std::iota(sorted.begin(), sorted.end(), 0u);
+    HilbertSort sort(xyz, std::move(sorted));
+    run_parallel(k + HilbertSort::kParts, threads, progress,
+                 [&](size_t i, Progress &p) {
+                   if (i < k)
+                     triangulate_own(xyz, ts[i], p);
+                   else
+                     sort.part(i - k);
+                 });
+    sorted = sort.take();
     for (Tile &t : ts) {
       for (auto v = t.dt.finite_vertices_begin();
            v != t.dt.finite_vertices_end(); ++v)
