@@ -481,7 +481,8 @@ int sc_params_can_tile(const sc_params_t *p);
     "tiles the points were split into (0: one triangulation of all)")          \
   X(tile_points_foreign, uint64_t, , COUNT, "tile_points_foreign",             \
     "points triangulated in a tile besides its own: the tiles' overhead; "     \
-    "with tiles 0, those a tile had taken in when it gave up")                 \
+    "with tiles 0, those a tile had taken in, or had found it must, when it "  \
+    "gave up")                                                                 \
   X(labelled, int, , BOOL, "labelled",                                         \
     "watertight: 1 when the Delaunay cells were labelled inside or outside "   \
     "for a closure (the patches left doubt, or watertight_labels); path "      \

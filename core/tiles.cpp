@@ -79,7 +79,7 @@ constexpr size_t kSampleStride = 32;
 constexpr size_t kLeastSample = 256;
 // Thrown by certify() when a tile gives up.
 struct NotTileable {
-  size_t foreign; // the points the tile had taken in
+  size_t foreign; // the points the tile had taken in, or was to take in
 };
 // Thrown by certify() when a tile within a memory limit grows past the
 // memory the limit leaves it (Shared::most_bytes).
@@ -1044,19 +1044,50 @@ void certify(const Shared &s, Tile &t, Progress &progress, bool ring,
       too_many();
     };
     // The points in add go in, and the cells they make are checked.
+    auto insert_and_check = [&](const std::vector<uint32_t> &pts) {
+      const std::vector<Vh> made = insert_foreign(s, t, pts, progress);
+      too_many();
+      for (Vh v : made) {
+        around.clear();
+        t.dt.incident_cells(v, std::back_inserter(around));
+        for (Ch c : around)
+          check(c);
+      }
+    };
+    // A tile that may give up and has many points to take in takes every
+    // kSampleStride-th of them first, once, and gives up at once where
+    // all of them, at what the sample's cells cost a point, would cost
+    // more than kMostWork a point it owns (as its first pass does). The
+    // points that sample's cells find join the rest; a tile may then take
+    // in a few points more than in one batch, never fewer than its cells
+    // need, so its cells and the mesh are the same.
+    bool drain_sampled = !give_up;
+    std::vector<uint32_t> batch;
     auto drain = [&]() {
       while (!add.empty()) {
         std::sort(add.begin(), add.end());
         add.erase(std::unique(add.begin(), add.end()), add.end());
-        const std::vector<Vh> made = insert_foreign(s, t, add, progress);
+        // Every point found goes in: a tile that will then hold too many
+        // gives up before it pays for their insertion.
+        if (double(t.foreign + add.size()) > most_foreign)
+          throw NotTileable{t.foreign + add.size()};
+        batch.swap(add);
         add.clear();
-        too_many();
-        for (Vh v : made) {
-          around.clear();
-          t.dt.incident_cells(v, std::back_inserter(around));
-          for (Ch c : around)
-            check(c);
+        if (!drain_sampled && batch.size() >= kSampleStride * kLeastSample) {
+          drain_sampled = true;
+          std::vector<uint32_t> sample, rest;
+          for (size_t i = 0; i < batch.size(); ++i)
+            (i % kSampleStride == 0 ? sample : rest).push_back(batch[i]);
+          const double before = t.work;
+          insert_and_check(sample);
+          if (t.work + (t.work - before) * double(rest.size()) /
+                           double(sample.size()) >
+              most_work)
+            throw NotTileable{t.foreign + rest.size()};
+          add.insert(add.end(), rest.begin(), rest.end());
+          continue;
         }
+        insert_and_check(batch);
       }
     };
     // The wanted finite cells not yet certified, with how far beyond the
