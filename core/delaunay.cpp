@@ -54,6 +54,11 @@ using HilbertCmp = CGAL::internal::Hilbert_cmp_3<SortTraits, axis, up>;
 // axes and directions are those of the level's call with x the first axis
 // and nothing reversed.
 void HilbertSort::split() {
+  if (all_ > 0) {
+    reserve_resident(idx_, all_);
+    idx_.resize(all_);
+    std::iota(idx_.begin(), idx_.end(), 0u);
+  }
   boost::rand48 random;
   boost::random_number_generator<boost::rand48, std::ptrdiff_t> rng(random);
   CGAL::cpp98::random_shuffle(idx_.begin(), idx_.end(), rng);
@@ -80,7 +85,7 @@ void HilbertSort::split() {
 }
 
 void HilbertSort::part(size_t i) {
-  std::call_once(split_once_, [this] { split(); });
+  begin();
   const CGAL::Hilbert_sort_median_3<SortTraits, CGAL::Sequential_tag> sort(
       SortTraits{XyzMap{xyz_}});
   const auto b = idx_.begin() + std::ptrdiff_t(cut_[i]),

@@ -296,15 +296,22 @@ std::vector<typename DT::Cell_iterator> cell_slices(DT &dt, size_t k) {
 
 // A sort of point indices along a Hilbert curve of their points: CGAL's
 // hilbert_sort() with its median policy (the same shuffle, the same
-// splits, the same order), in parts that may run on threads. The first
-// part() to run makes the shuffle and the first level's splits (the others
-// wait for it); each then sorts an eighth of the indices alone. The order
-// does not depend on which parts run where, or when.
+// splits, the same order), in parts that may run on threads. begin(), or
+// else the first part() to run, makes the shuffle and the first level's
+// splits (the others wait for it); each part then sorts an eighth of the
+// indices alone. The order does not depend on which parts run where, or
+// when.
 class HilbertSort {
 public:
   static constexpr size_t kParts = 8;
   HilbertSort(const double *xyz, std::vector<uint32_t> idx)
       : xyz_(xyz), idx_(std::move(idx)) {}
+  // The indices 0 .. n-1, made (resident at once: prefault.hpp) by
+  // begin(), on its thread.
+  HilbertSort(const double *xyz, size_t n) : xyz_(xyz), all_(n) {}
+  void begin() {
+    std::call_once(split_once_, [this] { split(); });
+  }
   void part(size_t i);
   // The sorted indices, once every part has run.
   std::vector<uint32_t> take() { return std::move(idx_); }
@@ -313,6 +320,7 @@ private:
   void split();
   const double *xyz_;
   std::vector<uint32_t> idx_;
+  size_t all_ = 0;
   std::once_flag split_once_;
   size_t cut_[kParts + 1] = {};
 };
