@@ -4,6 +4,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 
 #include "edges.hpp"
+#include "prefault.hpp"
+
+#include <algorithm>
 
 namespace sc {
 namespace {
@@ -88,6 +91,40 @@ void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation) {
       std::memcpy(&tris[3 * (size_t(rstart[r]) + i)], part[i].v,
                   sizeof part[i].v);
   }
+}
+
+void merge_canonical(std::vector<std::vector<uint32_t>> &parts,
+                     std::vector<uint32_t> &out) {
+  struct Tri {
+    uint32_t v[3];
+  };
+  static_assert(sizeof(Tri) == 3 * sizeof(uint32_t), "packed triangles");
+  // Lexicographic on the three numbers, which canonical_order() sorts
+  // ascending within each triangle.
+  auto before = [](const Tri &a, const Tri &b) {
+    return a.v[0] != b.v[0]   ? a.v[0] < b.v[0]
+           : a.v[1] != b.v[1] ? a.v[1] < b.v[1]
+                              : a.v[2] < b.v[2];
+  };
+  auto tris = [](std::vector<uint32_t> &x) {
+    return reinterpret_cast<Tri *>(x.data());
+  };
+  auto merge = [&](std::vector<uint32_t> &a, std::vector<uint32_t> &b) {
+    std::vector<uint32_t> m;
+    reserve_resident(m, a.size() + b.size());
+    m.resize(a.size() + b.size());
+    std::merge(tris(a), tris(a) + a.size() / 3, tris(b), tris(b) + b.size() / 3,
+               tris(m), before);
+    a = std::move(m);
+    b = std::vector<uint32_t>();
+  };
+  // In rounds, each part with the one `step` after it.
+  for (size_t step = 1; step < parts.size(); step *= 2)
+    for (size_t i = 0; i + step < parts.size(); i += 2 * step)
+      merge(parts[i], parts[i + step]);
+  out = parts.empty() ? std::vector<uint32_t>() : std::move(parts[0]);
+  for (std::vector<uint32_t> &p : parts)
+    p = std::vector<uint32_t>();
 }
 
 } // namespace sc

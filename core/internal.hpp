@@ -277,6 +277,11 @@ void tally_loops(Surface &s);
 // facet depends on heap addresses; with this, two runs on the same points (a
 // daemon job and a local run) list the same triangles in the same order.
 void canonical_order(std::vector<uint32_t> &tris, bool keep_orientation);
+// The triangles of parts, each part in canonical_order() without
+// orientation and no triangle in two, in that order: what canonical_order()
+// of them all gives, by merging pairs of parts (the parts are emptied).
+void merge_canonical(std::vector<std::vector<uint32_t>> &parts,
+                     std::vector<uint32_t> &out);
 // Removes the closed components of fewer than min_triangles triangles (bubbles
 // between the layers of overlapping scans, section 11.1), and the open ones too
 // when open_too, from a surface that describe() filled; s and diag then

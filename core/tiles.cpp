@@ -1699,6 +1699,9 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
     select_candidates(t.dt, t.infinite, params, p, t.tris, t.diag, &own,
                       checks(params) ? &t.check : nullptr);
     drop(t);
+    // Each tile's in canonical order on its thread; their union then
+    // merges into the order of all (a facet is one tile's).
+    canonical_order(t.tris, false);
   };
   if (bounded) {
     // Within a memory limit, `threads` tiles at a time: the first pass
@@ -1787,20 +1790,18 @@ bool tiled_filter(const double *xyz, size_t n, size_t tiles, unsigned threads,
                  [&](size_t i, Progress &p) { candidates(ts[i], p); });
   }
 
-  size_t total = 0;
-  for (const Tile &t : ts)
-    total += t.tris.size();
-  out.tris.reserve(total);
-  for (Tile &t : ts) {
-    out.tris.insert(out.tris.end(), t.tris.begin(), t.tris.end());
-    out.check.append(std::move(t.check));
+  std::vector<std::vector<uint32_t>> parts(k);
+  for (size_t i = 0; i < k; ++i) {
+    Tile &t = ts[i];
+    parts[i] = std::move(t.tris);
     t.tris = {};
+    out.check.append(std::move(t.check));
     t.diag.tile_points_foreign = t.foreign;
     add_tile_counts(diag, t.diag);
   }
+  merge_canonical(parts, out.tris);
   diag.tiles = k;
   diag.candidates = out.tris.size() / 3;
-  canonical_order(out.tris, false);
   out.check.canonical();
   seconds[SC_STAGE_CANDIDATES] += sw.lap();
   return true;
