@@ -123,8 +123,7 @@ void merge_canonical(std::vector<std::vector<uint32_t>> &parts,
     for (size_t i = 0; i + step < parts.size(); i += 2 * step)
       merge(parts[i], parts[i + step]);
   out = parts.empty() ? std::vector<uint32_t>() : std::move(parts[0]);
-  for (std::vector<uint32_t> &p : parts)
-    p = std::vector<uint32_t>();
+  parts.clear();
 }
 
 } // namespace sc

@@ -112,20 +112,25 @@ void HilbertSort::part(size_t i) {
   }
 }
 
-void hilbert_sort(const double *xyz, std::vector<uint32_t> &idx) {
-  HilbertSort sort(xyz, std::move(idx));
+namespace {
+
+// Every part of sort, on this thread; its indices sorted.
+std::vector<uint32_t> sort_here(HilbertSort &sort) {
   for (size_t i = 0; i < HilbertSort::kParts; ++i)
     sort.part(i);
-  idx = sort.take();
+  return sort.take();
+}
+
+} // namespace
+
+void hilbert_sort(const double *xyz, std::vector<uint32_t> &idx) {
+  HilbertSort sort(xyz, std::move(idx));
+  idx = sort_here(sort);
 }
 
 std::vector<uint32_t> hilbert_order(const double *xyz, size_t n) {
-  std::vector<uint32_t> order;
-  reserve_resident(order, n);
-  order.resize(n);
-  std::iota(order.begin(), order.end(), 0u);
-  hilbert_sort(xyz, order);
-  return order;
+  HilbertSort sort(xyz, n);
+  return sort_here(sort);
 }
 
 namespace {
