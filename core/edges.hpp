@@ -150,8 +150,8 @@ struct EdgeTable {
              Progress &progress, bool angles = true, unsigned threads = 1) {
     // (Slices, where it pays: see kParallelTriangles.)
     const bool parallel = tris.size() >= 3 * kParallelTriangles;
-    auto sliced = [&](size_t count, double at, auto &&body) {
-      run_sliced(count, threads, parallel, progress, body, at);
+    auto sliced = [&](size_t count, double from, double to, auto &&body) {
+      run_sliced(count, threads, parallel, progress, body, from, to);
     };
     const size_t nt = tris.size() / 3;
     // Bucket the entries by their smaller vertex (a counting sort), then
@@ -167,7 +167,7 @@ struct EdgeTable {
     entries.resize(3 * nt);
     PrefaultVector<uint32_t> fill(count.begin(), count.end() - 1);
     for (size_t t = 0; t < nt; ++t) {
-      progress.tick(t, 2 * nt);
+      progress.tick(t, 4 * nt);
       for (int k = 0; k < 3; ++k) {
         uint32_t a = tris[3 * t + k], b = tris[3 * t + (k + 1) % 3];
         entries[fill[std::min(a, b)]++] = {edge_key(a, b), uint32_t(t),
@@ -177,20 +177,23 @@ struct EdgeTable {
     // A bucket holds a vertex's edges, filled in triangle order: a stable
     // sort by key alone, which keeps that order among the triangles of an
     // edge, sorts it by (key, triangle).
-    sliced(n, 0.5, [&](size_t b, size_t e) {
+    sliced(n, 0.25, 0.4, [&](size_t b, size_t e) {
       for (size_t v = b; v < e; ++v)
         sort_bucket(
             entries.data() + count[v], count[v + 1] - count[v],
             [](const Entry &x, const Entry &y) { return x.key < y.key; });
     });
-    index_edges(nt, &progress, angles);
+    {
+      Progress::Span span(progress, 0.4, 0.5);
+      index_edges(nt, &progress, angles);
+    }
     angle.clear();
     if (!angles)
       return;
     reserve_resident(angle, entries.size());
     angle.resize(entries.size());
     // Each edge's frame once, then its triangles by angle (ties by number).
-    sliced(edges(), 1.0, [&](size_t b, size_t end) {
+    sliced(edges(), 0.5, 1, [&](size_t b, size_t end) {
       for (size_t e = b; e < end; ++e)
         sort_by_angle(xyz, tris, e);
     });

@@ -7,6 +7,7 @@
 
 #include "shortcrust.h"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -49,22 +50,30 @@ void set_msg(char *msg, size_t len, const char *fmt, ...)
 int check_params(const sc_params_t *p, char *msg, size_t len);
 
 // Reports progress of one stage and turns a cancel request into an Error.
+// Within a stage the fraction never goes back: the steps of a stage each
+// report their own share through a Span, and a step that counts again
+// from 0 (a table built a second time) holds the bar where it is.
 class Progress {
 public:
   Progress(sc_progress_fn fn, void *user) : fn_(fn), user_(user) {}
+  // Enters stage s at 0; the stage it is in already goes on where it was.
   void stage(sc_stage_t s) {
-    stage_ = s;
-    report(0.0);
+    if (s != stage_ || !entered_) {
+      stage_ = s;
+      last_ = 0;
+    }
+    entered_ = true;
+    ++entries_;
+    lo_ = 0;
+    hi_ = 1;
+    send(last_);
   }
   void report(double fraction) {
-    last_ = fraction;
-    if (fn_ && fn_(user_, stage_, fraction))
-      throw Error(SC_ECANCELLED, "cancelled during stage " +
-                                     std::string(sc_stage_name(stage_)));
+    send(std::max(last_, lo_ + (hi_ - lo_) * fraction));
   }
   // While waiting for other threads: reports the last fraction again, so
   // that a cancel is taken.
-  void poll() { report(last_); }
+  void poll() { send(last_); }
   // For loops: report every `every` iterations (a power of two); i of
   // about n, never more than the whole.
   void tick(size_t i, size_t n, size_t every = 1u << 15) {
@@ -72,11 +81,45 @@ public:
       report(n && i < n ? double(i) / double(n) : 1.0);
   }
 
+  // While it lives, the fractions reported go to [from, to] of the part of
+  // the stage reported to before. (A stage entered meanwhile has its own
+  // parts: the span then ends with nothing to do.)
+  class Span {
+  public:
+    Span(Progress &p, double from, double to)
+        : p_(p), lo_(p.lo_), hi_(p.hi_), entries_(p.entries_) {
+      p.lo_ = lo_ + (hi_ - lo_) * from;
+      p.hi_ = lo_ + (hi_ - lo_) * to;
+    }
+    ~Span() {
+      if (p_.entries_ != entries_)
+        return;
+      p_.lo_ = lo_;
+      p_.hi_ = hi_;
+    }
+    Span(const Span &) = delete;
+    Span &operator=(const Span &) = delete;
+
+  private:
+    Progress &p_;
+    double lo_, hi_;
+    unsigned entries_;
+  };
+
 private:
+  void send(double f) {
+    last_ = f;
+    if (fn_ && fn_(user_, stage_, f))
+      throw Error(SC_ECANCELLED, "cancelled during stage " +
+                                     std::string(sc_stage_name(stage_)));
+  }
   sc_progress_fn fn_;
   void *user_;
   sc_stage_t stage_ = SC_STAGE_INPUT;
+  bool entered_ = false;
+  unsigned entries_ = 0; // stage() calls
   double last_ = 0;
+  double lo_ = 0, hi_ = 1; // the part of the stage reported to
 };
 
 // Shortcrust mode's check (docs/algorithm.md section 6.5), from the same
@@ -560,6 +603,10 @@ private:
   double label_theta() const;
   void smooth_if_noisy(const double *base, Progress &progress);
   sc_params_t params_;
+  // The caller's progress, from borrow() to the end of finish(): a stage
+  // that goes on there goes on where it was. (Chunks that arrive count
+  // each on their own: their number is not known.)
+  Progress progress_{params_.progress, params_.progress_user};
   std::vector<double> own_;
   const double *xyz_ = nullptr;
   size_t n_ = 0;

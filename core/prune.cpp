@@ -44,7 +44,12 @@ void prune(const double *xyz, size_t n, const std::vector<uint32_t> &cand,
            sc_diag_t &diag, unsigned threads) {
   table.reset(new EdgeTable);
   EdgeTable &et = *table;
-  et.build(xyz, n, cand, progress, true, threads);
+  {
+    // (The table takes about three quarters of the stage.)
+    Progress::Span span(progress, 0, 0.75);
+    et.build(xyz, n, cand, progress, true, threads);
+  }
+  Progress::Span span(progress, 0.75, 1);
   const size_t ne = et.edges();
   alive.assign(cand.size() / 3, 1);
   std::vector<uint32_t> work(ne);

@@ -708,7 +708,7 @@ void Recon::prepare(Progress &progress) {
 void Recon::prepare_and_insert(Progress &progress) {
   if (thread_count() < 2 || n_ < kEstimateBeside) {
     prepare(progress);
-    insert_range(work_, 0, n_);
+    insert_range(work_, 0, n_, progress);
     return;
   }
   Stopwatch sw;
@@ -766,15 +766,19 @@ void Recon::prepare_and_insert(Progress &progress) {
   if (cancelled && !beside.stop.load())
     std::rethrow_exception(cancelled);
   // Back to the input stage only to smooth: otherwise the triangulation
-  // stage goes on.
-  if (smooths(noise_))
+  // stage goes on, where the insertion left it.
+  if (smooths(noise_)) {
     progress.stage(SC_STAGE_INPUT);
+  } else {
+    progress.stage(SC_STAGE_DELAUNAY);
+    progress.report(1.0);
+  }
   smooth_if_noisy(base, progress);
   const double waited = sw.lap();
   seconds_denoise_ = estimate_seconds + waited;
   seconds_[SC_STAGE_INPUT] += waited;
   if (!dt_)
-    insert_range(work_, 0, n_);
+    insert_range(work_, 0, n_, progress);
 }
 
 void Recon::insert_range(const double *xyz, size_t first, size_t n) {
@@ -814,7 +818,7 @@ void Recon::borrow(const double *xyz, size_t n) {
   Stopwatch sw;
   if (n > kMaxPoints)
     throw Error(SC_ETOO_MANY_POINTS, sc_strerror(SC_ETOO_MANY_POINTS));
-  Progress progress(params_.progress, params_.progress_user);
+  Progress &progress = progress_;
   progress.stage(SC_STAGE_INPUT);
   check_finite(xyz, n, 0);
   xyz_ = xyz;
@@ -981,7 +985,7 @@ sc_mesh_t *Recon::finish() {
   struct ScratchRelease {
     ~ScratchRelease() { release_scratch(); }
   } scratch_release;
-  Progress progress(params_.progress, params_.progress_user);
+  Progress &progress = progress_;
   sc_diag_t diag;
   std::memset(&diag, 0, sizeof diag);
   diag.points_in = n_;
@@ -1026,7 +1030,7 @@ sc_mesh_t *Recon::finish() {
     if (!dt_)
       dt_ = std::move(begun);
     if (!dt_)
-      insert_range(work, 0, n_);
+      insert_range(work, 0, n_, progress);
     check_spread(n_, dt_.get());
     // Points inserted as they came are in the caller's frame: moved with
     // the rest, exactly.
@@ -1139,9 +1143,15 @@ sc_mesh_t *Recon::finish() {
   const sc_diag_t extracting = diag;
   // Watertight mode describes an open surface again once it is closed,
   // and checks its vertices then (fix_fans_in() leaves one fan at each).
-  extract(lxyz.data(), m, f.tris, alive, std::move(table),
-          scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary, progress,
-          surf, diag, !watertight, auto_unfilled ? &unfilled : nullptr);
+  {
+    // (Watertight mode's closing may take as long as the extraction.)
+    Progress::Span span(progress, 0, watertight ? 0.5 : 0.9);
+    extract(lxyz.data(), m, f.tris, alive, std::move(table),
+            scan_holes ? 0 : size_t(params_.max_hole_edges), f.boundary,
+            progress, surf, diag, !watertight,
+            auto_unfilled ? &unfilled : nullptr);
+  }
+  Progress::Span closing(progress, watertight ? 0.5 : 0.9, 1);
   if (detects_boundary(params_.mode)) {
     // Real scans: overlapping layers leave bubbles, small closed components
     // between them, and samples the walk passed by. Drop the bubbles;

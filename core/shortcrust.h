@@ -116,10 +116,13 @@ const char *sc_stage_name(int stage);
 
 /*
  * Progress callback: called from the thread running the reconstruction with
- * the current stage and the fraction of that stage done, in [0, 1]. Return 0
- * to go on, non-zero to cancel: the call then returns SC_ECANCELLED at the
- * next check (at most a few milliseconds of work later) and frees everything
- * it held.
+ * the current stage and the fraction of that stage done, in [0, 1]. Within
+ * a stage the fraction never goes back, on any number of threads and tiles;
+ * a stage may come again after a later one (the input stage, where the
+ * points are smoothed once the triangulation has begun), and each chunk of
+ * sc_recon_add() counts its insertion from 0. Return 0 to go on, non-zero
+ * to cancel: the call then returns SC_ECANCELLED at the next check (at most
+ * a few milliseconds of work later) and frees everything it held.
  */
 typedef int (*sc_progress_fn)(void *user, sc_stage_t stage, double fraction);
 

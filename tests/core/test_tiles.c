@@ -214,6 +214,61 @@ static int cancel_at(void *user, sc_stage_t stage, double fraction) {
   return stage == c->stage && ++c->calls > c->after;
 }
 
+/* Watches the progress of a job: the stages must come in order and,
+ * within one, the fraction must never go back. */
+typedef struct {
+  int stage, calls, back, in_delaunay;
+  double last;
+} watch_t;
+
+static int watch(void *user, sc_stage_t stage, double fraction) {
+  watch_t *w = user;
+  ++w->calls;
+  w->in_delaunay += stage == SC_STAGE_DELAUNAY;
+  if ((int)stage < w->stage || !(fraction >= 0 && fraction <= 1) ||
+      ((int)stage == w->stage && fraction < w->last))
+    ++w->back;
+  w->stage = (int)stage;
+  w->last = fraction;
+  return 0;
+}
+
+/* Tiles on two threads, in each mode that tiles, and one triangulation:
+ * the bar never goes back within a stage (a tile's phases, and the steps
+ * of pruning and extraction that count from 0 again, each have their
+ * share of the stage), and the mesh is that of one triangulation. */
+static void progress_forward(const double *xyz, size_t n) {
+  const sc_mode_t modes[] = {SC_MODE_COCONE, SC_MODE_BOUNDARY,
+                             SC_MODE_WATERTIGHT, SC_MODE_COCONE};
+  for (size_t m = 0; m < sizeof modes / sizeof *modes; ++m) {
+    const int tiled = m < 3;
+    sc_params_t p;
+    sc_params_init(&p);
+    p.mode = modes[m];
+    p.tiles = tiled ? 3 : 1;
+    p.threads = tiled ? 2 : 1;
+    watch_t w = {-1, 0, 0, 0, 0};
+    p.progress = watch;
+    p.progress_user = &w;
+    sc_mesh_t *t = run_with("torus, watched", xyz, n, &p);
+    sc_mesh_t *one = run("torus", xyz, n, modes[m], 1, 1);
+    char tag[160];
+    snprintf(tag, sizeof tag, "torus, %s, %s watched", sc_mode_name(modes[m]),
+             tiled ? "3 tiles" : "one triangulation");
+    if (t && one && same_output(tag, one, t)) {
+      if (w.back)
+        fprintf(stderr, "%s: the progress went back %d times in %d calls\n",
+                tag, w.back, w.calls);
+      EXPECT_EQ(w.back, 0);
+      EXPECT_GT(w.in_delaunay, 2);
+      EXPECT_EQ(w.stage, SC_STAGE_EXTRACT);
+      printf("ok: %s: %d calls, none back\n", tag, w.calls);
+    }
+    sc_mesh_free(t);
+    sc_mesh_free(one);
+  }
+}
+
 /* Watertight mode on two threads labels the cells beside the extraction
  * (docs/algorithm.md section 11.5), where boundary samples were found or
  * the triangulation is small, and stops where the patches settle the
@@ -493,6 +548,7 @@ int main(int argc, char **argv) {
 cancel : {
   EXPECT_EQ(scs_sample_surface(SCS_SURF_TORUS, SCS_DENSITY_UNIFORM, n, 7, xyz),
             0);
+  progress_forward(xyz, n);
   sc_params_t p;
   sc_params_init(&p);
   p.tiles = 4;
