@@ -545,7 +545,6 @@ private:
   bool apart() const { return params_.tile_count > 0 || merge_; }
   // How far each tile holds the points beyond its region from the start.
   double tile_margin() const { return 3 * noise_.spacing; }
-  void insert_range(const double *xyz, size_t first, size_t n);
   void insert_range(const double *xyz, size_t first, size_t n,
                     Progress &progress);
   // Auto mode: whether watertight mode's closing of surf, extracted with
@@ -603,9 +602,9 @@ private:
   double label_theta() const;
   void smooth_if_noisy(const double *base, Progress &progress);
   sc_params_t params_;
-  // The caller's progress, from borrow() to the end of finish(): a stage
-  // that goes on there goes on where it was. (Chunks that arrive count
-  // each on their own: their number is not known.)
+  // The caller's progress, from borrow() or the first add() to the end of
+  // finish(): a stage that goes on there goes on where it was. (Chunks
+  // that arrive count each on their own: their number is not known.)
   Progress progress_{params_.progress, params_.progress_user};
   std::vector<double> own_;
   const double *xyz_ = nullptr;

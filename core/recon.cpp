@@ -781,11 +781,6 @@ void Recon::prepare_and_insert(Progress &progress) {
     insert_range(work_, 0, n_, progress);
 }
 
-void Recon::insert_range(const double *xyz, size_t first, size_t n) {
-  Progress progress(params_.progress, params_.progress_user);
-  insert_range(xyz, first, n, progress);
-}
-
 void Recon::insert_range(const double *xyz, size_t first, size_t n,
                          Progress &progress) {
   if (n == 0)
@@ -809,7 +804,10 @@ void Recon::add(const double *xyz, size_t n) {
   n_ += n;
   seconds_[SC_STAGE_INPUT] += sw.lap();
   if (!defer_insertion()) {
-    insert_range(xyz_, first, n);
+    // Each chunk counts its insertion from 0: how many will come is not
+    // known. The stage then goes on from the last one's.
+    progress_ = Progress(params_.progress, params_.progress_user);
+    insert_range(xyz_, first, n, progress_);
     dt_raw_ = true;
   }
 }

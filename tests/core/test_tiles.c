@@ -267,6 +267,31 @@ static void progress_forward(const double *xyz, size_t n) {
     sc_mesh_free(t);
     sc_mesh_free(one);
   }
+  /* In chunks, each chunk counts its insertion from 0 (how many will come
+   * is not known), and the stage goes on from the last one's. */
+  sc_params_t p;
+  sc_params_init(&p);
+  watch_t w = {-1, 0, 0, 0, 0};
+  p.progress = watch;
+  p.progress_user = &w;
+  sc_recon_t *r = NULL;
+  char msg[256] = "";
+  EXPECT_EQ(sc_recon_new(&p, &r), 0);
+  const size_t chunks = 3;
+  for (size_t c = 0; r && c < chunks; ++c)
+    EXPECT_EQ(sc_recon_add(r, xyz + 3 * (n * c / chunks),
+                           n * (c + 1) / chunks - n * c / chunks, msg,
+                           sizeof msg),
+              0);
+  sc_mesh_t *m = NULL;
+  if (r)
+    EXPECT_EQ(sc_recon_finish(r, &m, msg, sizeof msg), 0);
+  sc_recon_free(r);
+  EXPECT_EQ(w.back, (int)chunks - 1);
+  EXPECT_EQ(w.stage, SC_STAGE_EXTRACT);
+  printf("ok: torus in %zu chunks watched: %d calls, back %d times\n", chunks,
+         w.calls, w.back);
+  sc_mesh_free(m);
 }
 
 /* Watertight mode on two threads labels the cells beside the extraction
