@@ -58,11 +58,10 @@ public:
   Progress(sc_progress_fn fn, void *user) : fn_(fn), user_(user) {}
   // Enters stage s at 0; the stage it is in already goes on where it was.
   void stage(sc_stage_t s) {
-    if (s != stage_ || !entered_) {
+    if (s != stage_) {
       stage_ = s;
       last_ = 0;
     }
-    entered_ = true;
     ++entries_;
     lo_ = 0;
     hi_ = 1;
@@ -116,7 +115,6 @@ private:
   sc_progress_fn fn_;
   void *user_;
   sc_stage_t stage_ = SC_STAGE_INPUT;
-  bool entered_ = false;
   unsigned entries_ = 0; // stage() calls
   double last_ = 0;
   double lo_ = 0, hi_ = 1; // the part of the stage reported to
